@@ -1,0 +1,5 @@
+"""``python -m microg``."""
+
+from microg.cli import _entry
+
+_entry()

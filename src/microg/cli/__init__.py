@@ -1,0 +1,101 @@
+"""The ``microg`` command line.
+
+Each subcommand lives in its own module of this package and only reads result objects
+from the library; it computes nothing itself.  Errors in the user's input are printed as
+one line on stderr with exit status 2 and no traceback (see :func:`main`).
+"""
+
+from __future__ import annotations
+
+import importlib
+import importlib.util
+import sys
+
+import click
+
+from microg import __version__
+from microg.errors import InputError
+
+__all__ = ["cli", "main"]
+
+#: subcommand name -> "module:attribute" (imported on first use, so ``microg --help`` is fast)
+SUBCOMMANDS: dict[str, str] = {
+    "analyze": "microg.cli.analyze:analyze",
+    "reproduce": "microg.cli.reproduce:reproduce",
+    "modes": "microg.cli.modes:modes",
+    "locate": "microg.cli.locate:locate",
+    "optimize": "microg.cli.locate:optimize",
+    "isolate": "microg.cli.isolate:isolate",
+}
+
+
+class LazyGroup(click.Group):
+    """A click group whose subcommands are imported on demand from :data:`SUBCOMMANDS`."""
+
+    def list_commands(self, ctx: click.Context) -> list[str]:
+        names = set(super().list_commands(ctx))
+        for name, target in SUBCOMMANDS.items():
+            if importlib.util.find_spec(target.split(":")[0]) is not None:
+                names.add(name)
+        return sorted(names)
+
+    def get_command(self, ctx: click.Context, cmd_name: str) -> click.Command | None:
+        cmd = super().get_command(ctx, cmd_name)
+        if cmd is not None:
+            return cmd
+        target = SUBCOMMANDS.get(cmd_name)
+        if target is None:
+            return None
+        module_name, attr = target.split(":")
+        if importlib.util.find_spec(module_name) is None:
+            return None
+        return getattr(importlib.import_module(module_name), attr)
+
+
+@click.group(cls=LazyGroup, context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(__version__, prog_name="microg")
+def cli() -> None:
+    """Microgravity environment of an orbiting space station.
+
+    Predicts the acceleration that crew motion causes anywhere on a station, checks it
+    against the ISS vibratory requirement, and designs experiment isolation.
+    """
+
+
+def _one_line(text: str) -> str:
+    return " ".join(str(text).split())
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point: run the CLI, turning input errors into one line and exit status 2."""
+    try:
+        cli.main(args=argv, prog_name="microg", standalone_mode=False)
+    except click.exceptions.NoSuchOption as exc:
+        hint = f"; did you mean {', '.join(exc.possibilities)}?" if exc.possibilities else ""
+        click.echo(f"microg: error: no such option {exc.option_name}{hint} (see --help)", err=True)
+        return 2
+    except click.exceptions.BadParameter as exc:
+        name = exc.param.opts[0] if exc.param is not None and exc.param.opts else exc.param_hint
+        click.echo(f"microg: error: {name}: {_one_line(exc.message)}", err=True)
+        return 2
+    except click.exceptions.UsageError as exc:
+        click.echo(f"microg: error: {_one_line(exc.format_message())} (see --help)", err=True)
+        return 2
+    except InputError as exc:
+        click.echo(f"microg: error: {_one_line(str(exc))}", err=True)
+        return 2
+    except click.exceptions.Abort:
+        click.echo("microg: aborted", err=True)
+        return 1
+    except click.exceptions.Exit as exc:
+        return exc.exit_code
+    except click.ClickException as exc:
+        click.echo(f"microg: error: {_one_line(exc.format_message())}", err=True)
+        return exc.exit_code
+    except BrokenPipeError:
+        return 1
+    return 0
+
+
+def _entry() -> None:  # pragma: no cover - used by ``python -m microg``
+    sys.exit(main())

@@ -1,0 +1,115 @@
+"""Click parameter types that parse physical quantities and ranges at the boundary."""
+
+from __future__ import annotations
+
+import click
+
+from microg.errors import InputError
+from microg.units import parse_quantity
+
+__all__ = ["QuantityType", "RangeType", "BandType", "PositiveFloat"]
+
+
+class QuantityType(click.ParamType):
+    """A physical quantity: ``"25 lbf"``, ``"111 N"``; a bare number takes ``default_unit``.
+
+    Converts to an SI float.  ``minimum``/``strict`` bound the SI value.
+    """
+
+    name = "quantity"
+
+    def __init__(
+        self,
+        dimension: str,
+        default_unit: str | None,
+        *,
+        minimum: float | None = None,
+        strict: bool = False,
+    ):
+        self.dimension = dimension
+        self.default_unit = default_unit
+        self.minimum = minimum
+        self.strict = strict
+
+    def get_metavar(self, param: click.Parameter, ctx: click.Context | None = None) -> str:
+        return "Q" if self.default_unit is None else f"Q[{self.default_unit}]"
+
+    def convert(self, value, param, ctx):  # type: ignore[no-untyped-def]
+        if isinstance(value, float):
+            return value
+        try:
+            si = parse_quantity(
+                value, self.dimension, where="value", default_unit=self.default_unit
+            )
+        except InputError as exc:
+            self.fail(f"{exc.what}" + (f" ({exc.fix})" if exc.fix else ""), param, ctx)
+        if self.minimum is not None:
+            bad = si <= self.minimum if self.strict else si < self.minimum
+            if bad:
+                op = ">" if self.strict else ">="
+                self.fail(f"must be {op} {self.minimum:g}, got {value!r}", param, ctx)
+        return si
+
+
+class PositiveFloat(click.ParamType):
+    """A plain float with an optional lower bound (strict or not)."""
+
+    name = "float"
+
+    def __init__(self, minimum: float = 0.0, strict: bool = True):
+        self.minimum = minimum
+        self.strict = strict
+
+    def convert(self, value, param, ctx):  # type: ignore[no-untyped-def]
+        try:
+            x = float(value)
+        except (TypeError, ValueError):
+            self.fail(f"expected a number, got {value!r}", param, ctx)
+        if x != x or x in (float("inf"), float("-inf")):
+            self.fail(f"expected a finite number, got {value!r}", param, ctx)
+        bad = x <= self.minimum if self.strict else x < self.minimum
+        if bad:
+            op = ">" if self.strict else ">="
+            self.fail(f"must be {op} {self.minimum:g}, got {value!r}", param, ctx)
+        return x
+
+
+class RangeType(click.ParamType):
+    """``START:STOP:N`` -> ``(start, stop, n)``, N >= 2 integer, START < STOP."""
+
+    name = "START:STOP:N"
+
+    def convert(self, value, param, ctx):  # type: ignore[no-untyped-def]
+        if isinstance(value, tuple):
+            return value
+        parts = str(value).split(":")
+        if len(parts) != 3:
+            self.fail(f"expected START:STOP:N, got {value!r}", param, ctx)
+        try:
+            start, stop = float(parts[0]), float(parts[1])
+            n = int(parts[2])
+        except ValueError:
+            self.fail(f"expected numbers in START:STOP:N, got {value!r}", param, ctx)
+        if not (start < stop) or n < 2:
+            self.fail(f"need START < STOP and N >= 2, got {value!r}", param, ctx)
+        return (start, stop, n)
+
+
+class BandType(click.ParamType):
+    """``LO:HI`` -> ``(lo, hi)`` with 0 <= LO < HI."""
+
+    name = "LO:HI"
+
+    def convert(self, value, param, ctx):  # type: ignore[no-untyped-def]
+        if isinstance(value, tuple):
+            return value
+        parts = str(value).split(":")
+        if len(parts) != 2:
+            self.fail(f"expected LO:HI, got {value!r}", param, ctx)
+        try:
+            lo, hi = float(parts[0]), float(parts[1])
+        except ValueError:
+            self.fail(f"expected numbers in LO:HI, got {value!r}", param, ctx)
+        if not (0 <= lo < hi) or hi == float("inf"):
+            self.fail(f"need 0 <= LO < HI < inf, got {value!r}", param, ctx)
+        return (lo, hi)

@@ -1,0 +1,142 @@
+"""Unit parsing at the boundary: strings such as ``"25 lbf"`` become SI floats.
+
+Everything inside microg computes in SI (m, kg, s, N, rad).  This module is the only
+place that knows about units; physics kernels never import it.
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+
+import pint
+
+from microg.errors import InputError
+
+__all__ = [
+    "G0",
+    "G0_US",
+    "ureg",
+    "parse_quantity",
+    "to_si",
+    "format_quantity",
+    "DIMENSIONS",
+]
+
+#: standard gravity, m/s^2 (used to express accelerations in g)
+G0 = 9.80665
+#: the report's weight-to-mass conversion, ft/s^2 (608,600 lb / 32.2 = 18,900 slug, Appendix C-1)
+G0_US = 32.2
+
+ureg = pint.UnitRegistry()
+ureg.define("micro_g = 1e-6 * standard_gravity = ug")
+ureg.define("milli_g = 1e-3 * standard_gravity = mg_accel")
+
+#: named dimensions accepted by :func:`parse_quantity`, with the SI unit of the float it returns
+DIMENSIONS: dict[str, str] = {
+    "length": "m",
+    "mass": "kg",
+    "force": "N",
+    "time": "s",
+    "frequency": "Hz",
+    "angular_frequency": "rad/s",
+    "stiffness": "N/m",
+    "bending_stiffness": "N*m^2",
+    "torsional_stiffness": "N*m^2",
+    "axial_stiffness": "N",
+    "mass_per_length": "kg/m",
+    "rotary_inertia": "kg*m^2",
+    "acceleration": "m/s^2",
+    "dimensionless": "",
+    "damping": "N*s/m",
+}
+
+
+@lru_cache(maxsize=64)
+def _unit(name: str) -> pint.Unit:
+    return ureg.Unit(name)
+
+
+def parse_quantity(
+    text: str | float | int,
+    dimension: str,
+    *,
+    where: str,
+    default_unit: str | None = None,
+) -> float:
+    """Parse ``text`` as a quantity of ``dimension`` and return its value in SI.
+
+    Parameters
+    ----------
+    text : str or number
+        ``"296 ft"``, ``"1.31e9 lbf*ft^2"``, ``"25 lbf"``; a bare number takes ``default_unit``.
+    dimension : str
+        A key of :data:`DIMENSIONS`.
+    where : str
+        Where the value came from (option name, ``file: field``), for the error message.
+    default_unit : str, optional
+        Unit of a bare number.  Without it a bare number is an error (except dimensionless).
+
+    Returns
+    -------
+    float
+        The value in the SI unit of ``DIMENSIONS[dimension]``.
+    """
+    si = DIMENSIONS[dimension]
+    if isinstance(text, bool):
+        raise InputError(
+            f"expected a {dimension} such as '1 {si or ''}', got {text!r}", where=where
+        )
+    if isinstance(text, int | float):
+        if dimension == "dimensionless":
+            return float(text)
+        if default_unit is None:
+            raise InputError(
+                f"bare number {text!r} has no unit",
+                where=where,
+                fix=f"write it with a unit, e.g. '{text} {si}', or declare a unit system",
+            )
+        text = f"{text} {default_unit}"
+    try:
+        q = ureg.Quantity(str(text).strip())
+    except (pint.errors.PintError, ValueError, TypeError, AttributeError, SyntaxError) as exc:
+        raise InputError(
+            f"cannot read {text!r} as a {dimension}: {exc}".replace("\n", " "),
+            where=where,
+            fix=f"write a number and a unit, e.g. '1 {si}'",
+        ) from None
+    if not isinstance(q, pint.Quantity):
+        q = ureg.Quantity(float(q), default_unit or "")
+    if q.dimensionless and dimension != "dimensionless":
+        if default_unit is None:
+            raise InputError(
+                f"{text!r} has no unit",
+                where=where,
+                fix=f"write it with a unit of {dimension}, e.g. '{q.magnitude} {si}'",
+            )
+        q = ureg.Quantity(q.magnitude, default_unit)
+    try:
+        value = q.to(_unit(si) if si else ureg.dimensionless).magnitude
+    except pint.errors.DimensionalityError:
+        raise InputError(
+            f"{text!r} is not a {dimension} (its unit is {q.units:~})",
+            where=where,
+            fix=f"use a unit of {dimension}, e.g. {si or 'a plain number'}",
+        ) from None
+    return float(value)
+
+
+def to_si(value: float, unit: str) -> float:
+    """Convert ``value`` in ``unit`` to SI base units."""
+    return float(ureg.Quantity(value, unit).to_base_units().magnitude)
+
+
+def from_si(value: float, si_unit: str, unit: str) -> float:
+    """Convert ``value`` from ``si_unit`` to ``unit``."""
+    return float(ureg.Quantity(value, si_unit).to(unit).magnitude)
+
+
+def format_quantity(value: float, si_unit: str, unit: str | None = None, digits: int = 4) -> str:
+    """Format an SI value for output, optionally converted to ``unit``."""
+    if unit is None:
+        return f"{value:.{digits}g} {si_unit}"
+    return f"{from_si(value, si_unit, unit):.{digits}g} {unit}"
