@@ -1,0 +1,199 @@
+"""The report's crew push-off/landing force (Eq. 2.16) and its exact modal response.
+
+The force ramps from 0 to ``f0`` over ``(0, t1]``, is zero until ``t13``, jumps to
+``(f0/t1)(t13 - t14)`` (``-f0`` when ``t14 - t13 = t1``) and ramps back to zero at ``t14``.
+For an undamped mode ``eta'' + w^2 eta = f(t)`` from rest (Eq. 2.15) the response is written
+``eta = f0/(w^3 t1) U(t)`` (Eq. 2.17) and ``eta'' = f0/(w t1) A(t)`` (Eq. 2.18).
+
+By superposition of ramps and steps (Duhamel), with ``H_a = H(t - a)``::
+
+    f(t) = (f0/t1) [r(t) - r(t-t1) - t1 H_t1 + r(t-t13) - (t14-t13) H_t13 - r(t-t14)]
+
+and the unit-ramp and unit-step responses ``(w s - sin w s)/w^3`` and ``(1 - cos w s)/w^2``
+give, on all four intervals (2.17c and 2.19d are missing from the OCR; derived here)::
+
+    U = [w t - sin w t] - [w s1 - sin w s1 + w t1 (1 - cos w s1)] H_t1
+        + [w s13 - sin w s13 - w (t14-t13)(1 - cos w s13)] H_t13 - [w s14 - sin w s14] H_t14
+    A = sin w t - [sin w s1 + w t1 cos w s1] H_t1
+        + [sin w s13 - w (t14-t13) cos w s13] H_t13 - sin w s14 H_t14
+
+with ``s_a = t - a``.  They satisfy ``A = w t1 f/f0 - U`` (the equation of motion).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from microg.errors import InputError
+
+__all__ = ["CrewPushoff", "displacement_u", "acceleration_a", "accel_amax", "force"]
+
+
+@dataclass(frozen=True)
+class CrewPushoff:
+    """The crew force of Eq. 2.16.
+
+    Attributes
+    ----------
+    f0 : float
+        Peak force, N (the report: 25 lbf = 111.2 N).
+    t1 : float
+        Push-off ramp duration, s (1 s).
+    t13 : float
+        Landing start, s (13 s).
+    t14 : float
+        Landing end, s (14 s).
+    """
+
+    f0: float
+    t1: float = 1.0
+    t13: float = 13.0
+    t14: float = 14.0
+
+    @classmethod
+    def checked(cls, f0: float, t1: float, t13: float, t14: float) -> CrewPushoff:
+        """Validate ``0 < t1 <= t13 < t14`` and a finite non-zero ``f0``."""
+        vals = {"f0": f0, "t1": t1, "t13": t13, "t14": t14}
+        for name, v in vals.items():
+            if not np.isfinite(v):
+                raise InputError(f"must be finite, got {v}", where=f"--{name}")
+        if f0 == 0:
+            raise InputError("must not be zero", where="--f0")
+        if not t1 > 0:
+            raise InputError(f"must be > 0 s, got {t1:g}", where="--t1")
+        if not t13 >= t1:
+            raise InputError(f"must be >= --t1 ({t1:g} s), got {t13:g}", where="--t13")
+        if not t14 > t13:
+            raise InputError(f"must be > --t13 ({t13:g} s), got {t14:g}", where="--t14")
+        return cls(float(f0), float(t1), float(t13), float(t14))
+
+    @property
+    def impulse_pushoff(self) -> float:
+        """Impulse of the push-off ramp, f0 t1 / 2, N s (Eq. 2.32)."""
+        return 0.5 * self.f0 * self.t1
+
+    def breakpoints(self) -> tuple[np.ndarray, np.ndarray]:
+        """Piecewise-linear breakpoints (times s, force N); a repeated time is a jump."""
+        land = self.f0 / self.t1 * (self.t13 - self.t14)
+        t = np.array([0.0, self.t1, self.t1, self.t13, self.t13, self.t14])
+        f = np.array([0.0, self.f0, 0.0, 0.0, land, 0.0])
+        return t, f
+
+
+def force(p: CrewPushoff, t: np.ndarray) -> np.ndarray:
+    """Crew force f(t) of Eq. 2.16 (right-continuous at the jumps), N."""
+    t = np.asarray(t, float)
+    out = np.where((t > 0) & (t <= p.t1), p.f0 / p.t1 * t, 0.0)
+    out = np.where((t > p.t13) & (t <= p.t14), p.f0 / p.t1 * (t - p.t14), out)
+    return out
+
+
+def _h(x: np.ndarray) -> np.ndarray:
+    return (x > 0).astype(float)
+
+
+def displacement_u(omega: np.ndarray | float, t: np.ndarray, p: CrewPushoff) -> np.ndarray:
+    """Dimensionless displacement U(t) (Eqs. 2.17a-d), broadcast over ``omega`` and ``t``.
+
+    Parameters
+    ----------
+    omega : float or ndarray
+        Modal frequency, rad/s (> 0).
+    t : ndarray
+        Times, s.
+    p : CrewPushoff
+    """
+    w = np.asarray(omega, float)
+    t = np.asarray(t, float)
+    s1, s13, s14 = t - p.t1, t - p.t13, t - p.t14
+    d = p.t14 - p.t13
+    u = (w * t - np.sin(w * t)) * _h(t)
+    u = u - (w * s1 - np.sin(w * s1) + w * p.t1 * (1 - np.cos(w * s1))) * _h(s1)
+    u = u + (w * s13 - np.sin(w * s13) - w * d * (1 - np.cos(w * s13))) * _h(s13)
+    u = u - (w * s14 - np.sin(w * s14)) * _h(s14)
+    return u
+
+
+def acceleration_a(omega: np.ndarray | float, t: np.ndarray, p: CrewPushoff) -> np.ndarray:
+    """Dimensionless acceleration A(t) (Eqs. 2.19a-d), broadcast over ``omega`` and ``t``.
+
+    Parameters
+    ----------
+    omega : float or ndarray
+        Modal frequency, rad/s.
+    t : ndarray
+        Times, s.
+    p : CrewPushoff
+    """
+    w = np.asarray(omega, float)
+    t = np.asarray(t, float)
+    s1, s13, s14 = t - p.t1, t - p.t13, t - p.t14
+    d = p.t14 - p.t13
+    a = np.sin(w * t) * _h(t)
+    a = a - (np.sin(w * s1) + w * p.t1 * np.cos(w * s1)) * _h(s1)
+    a = a + (np.sin(w * s13) - w * d * np.cos(w * s13)) * _h(s13)
+    a = a - np.sin(w * s14) * _h(s14)
+    return a
+
+
+def _interval_coeffs(
+    w: np.ndarray, p: CrewPushoff
+) -> list[tuple[float, float, np.ndarray, np.ndarray]]:
+    """A(t) = alpha sin wt + beta cos wt on each interval: (start, stop, alpha, beta)."""
+    d = p.t14 - p.t13
+    zero = np.zeros_like(w)
+    one = np.ones_like(w)
+
+    def shifted(a: float, c_sin: np.ndarray, c_cos: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        # c_sin sin w(t-a) + c_cos cos w(t-a) in terms of sin wt, cos wt
+        ca, sa = np.cos(w * a), np.sin(w * a)
+        return c_sin * ca + c_cos * sa, -c_sin * sa + c_cos * ca
+
+    a1, b1 = one, zero
+    x, y = shifted(p.t1, -one, -w * p.t1)
+    a2, b2 = a1 + x, b1 + y
+    x, y = shifted(p.t13, one, -w * d)
+    a3, b3 = a2 + x, b2 + y
+    x, y = shifted(p.t14, -one, zero)
+    a4, b4 = a3 + x, b3 + y
+    return [
+        (0.0, p.t1, a1, b1),
+        (p.t1, p.t13, a2, b2),
+        (p.t13, p.t14, a3, b3),
+        (p.t14, np.inf, a4, b4),
+    ]
+
+
+def accel_amax(omega: np.ndarray | float, p: CrewPushoff) -> np.ndarray:
+    """Exact max over t >= 0 of |A(t)|, [A]max of Eq. 3.1, vectorised over ``omega``.
+
+    On each interval A is a sinusoid ``R sin(w t + phi)``: its maximum is ``R`` when a crest
+    falls inside the interval, else the larger endpoint value.  After ``t14`` the free
+    vibration's amplitude counts (the mode is undamped).
+
+    Parameters
+    ----------
+    omega : float or ndarray
+        Modal frequency, rad/s (> 0).
+    p : CrewPushoff
+    """
+    w = np.atleast_1d(np.asarray(omega, float))
+    best = np.zeros_like(w)
+    for start, stop, alpha, beta in _interval_coeffs(w, p):
+        amp = np.hypot(alpha, beta)
+        if np.isinf(stop):
+            best = np.maximum(best, amp)
+            continue
+        phase = np.arctan2(beta, alpha)  # A = amp sin(w t + phase)
+        # crests at w t + phase = pi/2 + k pi; is there one with t in [start, stop]?
+        k_lo = np.ceil((w * start + phase - np.pi / 2) / np.pi)
+        t_crest = (np.pi / 2 + k_lo * np.pi - phase) / w
+        inside = t_crest <= stop
+        ends = np.maximum(
+            np.abs(alpha * np.sin(w * start) + beta * np.cos(w * start)),
+            np.abs(alpha * np.sin(w * stop) + beta * np.cos(w * stop)),
+        )
+        best = np.maximum(best, np.where(inside, amp, ends))
+    return best if np.ndim(omega) else best[0]
