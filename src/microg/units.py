@@ -48,6 +48,8 @@ DIMENSIONS: dict[str, str] = {
     "acceleration": "m/s^2",
     "dimensionless": "",
     "damping": "N*s/m",
+    "gravitational_parameter": "m^3/s^2",
+    "force_per_length": "N/m",
 }
 
 
