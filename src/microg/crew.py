@@ -1,21 +1,23 @@
 """The report's crew push-off/landing force (Eq. 2.16) and its exact modal response.
 
-The force ramps from 0 to ``f0`` over ``(0, t1]``, is zero until ``t13``, jumps to
-``(f0/t1)(t13 - t14)`` (``-f0`` when ``t14 - t13 = t1``) and ramps back to zero at ``t14``.
+The force ramps from 0 to ``f0`` over ``(0, t1]``, is zero until ``t13``, jumps to ``-f0``
+and ramps back to zero at ``t14`` (the seed review's reading of Eq. 2.16; the printed slope
+``f0/t1`` of the landing ramp is the same when ``t14 - t13 = t1``, the report's case).
 For an undamped mode ``eta'' + w^2 eta = f(t)`` from rest (Eq. 2.15) the response is written
 ``eta = f0/(w^3 t1) U(t)`` (Eq. 2.17) and ``eta'' = f0/(w t1) A(t)`` (Eq. 2.18).
 
 By superposition of ramps and steps (Duhamel), with ``H_a = H(t - a)``::
 
-    f(t) = (f0/t1) [r(t) - r(t-t1) - t1 H_t1 + r(t-t13) - (t14-t13) H_t13 - r(t-t14)]
+    f(t) = f0 [r(t)/t1 - r(t-t1)/t1 - H_t1 - H_t13 + r(t-t13)/d - r(t-t14)/d],  d = t14 - t13
 
 and the unit-ramp and unit-step responses ``(w s - sin w s)/w^3`` and ``(1 - cos w s)/w^2``
 give, on all four intervals (2.17c and 2.19d are missing from the OCR; derived here)::
 
     U = [w t - sin w t] - [w s1 - sin w s1 + w t1 (1 - cos w s1)] H_t1
-        + [w s13 - sin w s13 - w (t14-t13)(1 - cos w s13)] H_t13 - [w s14 - sin w s14] H_t14
+        + [(t1/d)(w s13 - sin w s13) - w t1 (1 - cos w s13)] H_t13
+        - (t1/d) [w s14 - sin w s14] H_t14
     A = sin w t - [sin w s1 + w t1 cos w s1] H_t1
-        + [sin w s13 - w (t14-t13) cos w s13] H_t13 - sin w s14 H_t14
+        + [(t1/d) sin w s13 - w t1 cos w s13] H_t13 - (t1/d) sin w s14 H_t14
 
 with ``s_a = t - a``.  They satisfy ``A = w t1 f/f0 - U`` (the equation of motion).
 """
@@ -76,17 +78,16 @@ class CrewPushoff:
 
     def breakpoints(self) -> tuple[np.ndarray, np.ndarray]:
         """Piecewise-linear breakpoints (times s, force N); a repeated time is a jump."""
-        land = self.f0 / self.t1 * (self.t13 - self.t14)
         t = np.array([0.0, self.t1, self.t1, self.t13, self.t13, self.t14])
-        f = np.array([0.0, self.f0, 0.0, 0.0, land, 0.0])
+        f = np.array([0.0, self.f0, 0.0, 0.0, -self.f0, 0.0])
         return t, f
 
 
 def force(p: CrewPushoff, t: np.ndarray) -> np.ndarray:
-    """Crew force f(t) of Eq. 2.16 (right-continuous at the jumps), N."""
+    """Crew force f(t) of Eq. 2.16, N; as printed, each interval is closed on the right."""
     t = np.asarray(t, float)
     out = np.where((t > 0) & (t <= p.t1), p.f0 / p.t1 * t, 0.0)
-    out = np.where((t > p.t13) & (t <= p.t14), p.f0 / p.t1 * (t - p.t14), out)
+    out = np.where((t > p.t13) & (t <= p.t14), p.f0 / (p.t14 - p.t13) * (t - p.t14), out)
     return out
 
 
@@ -108,11 +109,11 @@ def displacement_u(omega: np.ndarray | float, t: np.ndarray, p: CrewPushoff) -> 
     w = np.asarray(omega, float)
     t = np.asarray(t, float)
     s1, s13, s14 = t - p.t1, t - p.t13, t - p.t14
-    d = p.t14 - p.t13
+    r = p.t1 / (p.t14 - p.t13)
     u = (w * t - np.sin(w * t)) * _h(t)
     u = u - (w * s1 - np.sin(w * s1) + w * p.t1 * (1 - np.cos(w * s1))) * _h(s1)
-    u = u + (w * s13 - np.sin(w * s13) - w * d * (1 - np.cos(w * s13))) * _h(s13)
-    u = u - (w * s14 - np.sin(w * s14)) * _h(s14)
+    u = u + (r * (w * s13 - np.sin(w * s13)) - w * p.t1 * (1 - np.cos(w * s13))) * _h(s13)
+    u = u - r * (w * s14 - np.sin(w * s14)) * _h(s14)
     return u
 
 
@@ -130,11 +131,11 @@ def acceleration_a(omega: np.ndarray | float, t: np.ndarray, p: CrewPushoff) -> 
     w = np.asarray(omega, float)
     t = np.asarray(t, float)
     s1, s13, s14 = t - p.t1, t - p.t13, t - p.t14
-    d = p.t14 - p.t13
+    r = p.t1 / (p.t14 - p.t13)
     a = np.sin(w * t) * _h(t)
     a = a - (np.sin(w * s1) + w * p.t1 * np.cos(w * s1)) * _h(s1)
-    a = a + (np.sin(w * s13) - w * d * np.cos(w * s13)) * _h(s13)
-    a = a - np.sin(w * s14) * _h(s14)
+    a = a + (r * np.sin(w * s13) - w * p.t1 * np.cos(w * s13)) * _h(s13)
+    a = a - r * np.sin(w * s14) * _h(s14)
     return a
 
 
@@ -142,7 +143,7 @@ def _interval_coeffs(
     w: np.ndarray, p: CrewPushoff
 ) -> list[tuple[float, float, np.ndarray, np.ndarray]]:
     """A(t) = alpha sin wt + beta cos wt on each interval: (start, stop, alpha, beta)."""
-    d = p.t14 - p.t13
+    r = p.t1 / (p.t14 - p.t13)
     zero = np.zeros_like(w)
     one = np.ones_like(w)
 
@@ -154,9 +155,9 @@ def _interval_coeffs(
     a1, b1 = one, zero
     x, y = shifted(p.t1, -one, -w * p.t1)
     a2, b2 = a1 + x, b1 + y
-    x, y = shifted(p.t13, one, -w * d)
+    x, y = shifted(p.t13, r * one, -w * p.t1)
     a3, b3 = a2 + x, b2 + y
-    x, y = shifted(p.t14, -one, zero)
+    x, y = shifted(p.t14, -r * one, zero)
     a4, b4 = a3 + x, b3 + y
     return [
         (0.0, p.t1, a1, b1),

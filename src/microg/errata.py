@@ -196,7 +196,7 @@ def build_errata(rep: Reproduction) -> list[ErrataEntry]:
         else:
             why = f"printed/recomputed = {ratio:.3f}"
         add(f"Table 4 {case}", "libration a_e (g)", lib.printed_accel_g, lib.accel_g, why)
-    xo = rep.table4["xz_orbiter"]
+    xo = rep.table4.get("xz_orbiter") or next(iter(rep.table4.values()))
     out.append(
         ErrataEntry(
             "Eq. 3.1 / Table 4",
@@ -249,7 +249,15 @@ def _ocr(case: str) -> dict[tuple[int, int], tuple[float, float]]:
 _TEXT_ERRATA: list[tuple[str, tuple[str, str]]] = [
     ("Eq. 2.15", ("equation", "reads eta'' + w^2 eta = f_a(t), zero initial conditions")),
     ("Eq. 2.17c", ("missing", "derived by superposing ramps and steps (microg.crew)")),
-    ("Eq. 2.17d", ("cos w(t2 - t13)", "cos w(t - t13); general form w (t14 - t13) cos w(t - t13)")),
+    ("Eq. 2.17d", ("cos w(t2 - t13)", "cos w(t - t13)")),
+    (
+        "Eq. 2.16",
+        (
+            "landing (f0/t1)(t - t14)",
+            "read as a jump to -f0 ramping to 0 at t14 (seed "
+            "review); identical to the printed slope when t14 - t13 = t1",
+        ),
+    ),
     (
         "Eq. 2.19d",
         (

@@ -34,7 +34,7 @@ def render_reproduction(rep: Reproduction, fig3_uri: str, fig4_uri: str) -> str:
         appendix=to_jsonable(rep.appendix_c),
         errata=rep.errata,
         model_mass=data["model_mass_properties"],
-        rigid_g=rep.table4["xz_orbiter"].rigid_translation_accel_g,
+        rigid_g=next(iter(rep.table4.values())).rigid_translation_accel_g,
         fig3=fig3_uri,
         fig4=fig4_uri,
         amax=list(zip(rep.curves.omega.tolist(), rep.curves.amax.tolist(), strict=True)),

@@ -82,12 +82,12 @@ def report_cantilever_function() -> Polynomial:
 def cantilever_functions(n: int) -> list[Polynomial]:
     """``n`` admissible cantilever functions on xi in [0, 1]; the first is the report's.
 
-    Functions 2..n are xi^2 P_k(2 xi - 1) (shifted Legendre, k = 0..n-2), which with the
+    Functions 2..n are xi^3 P_k(2 xi - 1) (shifted Legendre, k = 0..n-2), which with the
     first span the polynomials xi^2..xi^(n+1) and stay well conditioned.
     """
     funcs = [report_cantilever_function()]
     x = Polynomial([-1.0, 2.0])  # 2 xi - 1
-    xi2 = Polynomial([0.0, 0.0, 1.0])
+    xi2 = Polynomial([0.0, 0.0, 0.0, 1.0])
     for k in range(n - 1):
         coef = np.zeros(k + 1)
         coef[k] = 1.0

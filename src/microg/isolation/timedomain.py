@@ -1,0 +1,340 @@
+"""Package acceleration for a sampled mount acceleration history, exact for piecewise-linear input.
+
+The package ``m1`` on the mount spring ``k1`` (and optional parallel damper ``c1``, not in the
+report), with the optional absorber ``m2``, ``k2``, ``c`` of the report's Figure 7 (Eq. 4.1), is
+linear and time invariant.  In relative coordinates ``z_i = u_i - u0``
+
+    m1 z1'' + c1 z1' + c (z1' - z2') + k1 z1 + k2 (z1 - z2) = -m1 a0(t)
+    m2 z2'' + c (z2' - z1') + k2 (z2 - z1) = -m2 a0(t)
+
+and the package's absolute acceleration is ``u1'' = z1'' + a0`` (no feedthrough).  Writing this as
+``x' = A x + B a0``, ``y = C x`` and taking ``a0`` linear between samples (first-order hold), the
+exact step from ``t_j`` to ``t_j + h`` is read from one matrix exponential of the augmented matrix
+
+    expm(h [[A, B, 0], [0, 0, 1], [0, 0, 0]]) = [[Phi, G1, G2], [0, 1, h], [0, 0, 1]],
+    x_{j+1} = Phi x_j + G1 a0_j + G2 (a0_{j+1} - a0_j)/h.
+
+One exponential per distinct step (steps equal to within the rounding of the time points share
+one); the recursion is evaluated as a chunked parallel prefix scan of the affine maps (vectorised,
+no loop over samples), so non-uniform steps cost nothing extra.
+
+Initial condition: the package (and absorber) start at rest relative to the mount, ``z = z' = 0``
+at ``timepts[0]``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy import linalg
+
+from microg.errors import InputError
+
+__all__ = [
+    "IsolatorModel",
+    "IsolationTimeResponse",
+    "state_space",
+    "foh_discretize",
+    "package_response",
+]
+
+_CHUNK = 4096
+
+
+@dataclass(frozen=True)
+class IsolatorModel:
+    """Physical isolator: package on a mount spring, optional absorber (report Figure 7).
+
+    Attributes
+    ----------
+    m1 : package mass, kg.
+    k1 : mount spring stiffness, N/m.
+    m2 : absorber mass, kg (0 for no absorber).
+    k2 : absorber spring stiffness, N/m.
+    c : absorber damping coefficient, N s/m (acts on ``u1 - u2``).
+    c1 : mount damping coefficient, N s/m (acts on ``u1 - u0``; 0 in the report's model).
+    """
+
+    m1: float
+    k1: float
+    m2: float = 0.0
+    k2: float = 0.0
+    c: float = 0.0
+    c1: float = 0.0
+
+    def __post_init__(self) -> None:
+        for name in ("m1", "k1"):
+            v = getattr(self, name)
+            if not (math.isfinite(v) and v > 0):
+                raise InputError(f"must be a finite number > 0, got {v!r}", where=name)
+        for name in ("m2", "k2", "c", "c1"):
+            v = getattr(self, name)
+            if not (math.isfinite(v) and v >= 0):
+                raise InputError(f"must be a finite number >= 0, got {v!r}", where=name)
+        if (self.m2 > 0) != (self.k2 > 0) or (self.m2 == 0 and self.c > 0):
+            raise InputError(
+                "an absorber needs both m2 > 0 and k2 > 0 (and c only with them)",
+                where="m2/k2/c",
+                fix="give m2, k2 (and c) together, or none",
+            )
+
+    @property
+    def has_absorber(self) -> bool:
+        """True when an absorber mass is attached."""
+        return self.m2 > 0
+
+    @property
+    def omega_n(self) -> float:
+        """Mount natural frequency ``sqrt(k1/m1)``, rad/s (Eq. 4.6)."""
+        return math.sqrt(self.k1 / self.m1)
+
+    @classmethod
+    def from_dimensionless(
+        cls,
+        m1: float,
+        k1: float,
+        k: float | None = None,
+        mu: float | None = None,
+        zeta: float = 0.0,
+    ) -> IsolatorModel:
+        """Build from the package and the report's ratios ``k = k1/k2``, ``mu = m2/m1``, ``zeta``.
+
+        Parameters
+        ----------
+        m1 : float
+            Package mass, kg.
+        k1 : float
+            Mount stiffness, N/m.
+        k : float, optional
+            Spring ratio ``k1/k2`` (Eq. 4.6); None for no absorber.
+        mu : float, optional
+            Mass ratio ``m2/m1`` (Eq. 4.6); None for no absorber.
+        zeta : float
+            Absorber damping ratio ``c/(2 sqrt(m2 k2))`` (Eq. 4.6).
+        """
+        if k is None or mu is None:
+            return cls(m1=m1, k1=k1)
+        if not (k > 0 and mu > 0 and zeta >= 0):
+            raise InputError(
+                f"need k > 0, mu > 0, zeta >= 0, got k={k}, mu={mu}, zeta={zeta}", where="k/mu/zeta"
+            )
+        m2, k2 = mu * m1, k1 / k
+        return cls(m1=m1, k1=k1, m2=m2, k2=k2, c=2.0 * zeta * math.sqrt(m2 * k2))
+
+
+def state_space(
+    model: IsolatorModel,
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """``(A, B, C)`` from mount acceleration (m/s^2) to package absolute acceleration (m/s^2).
+
+    States ``[z1, z1']`` or, with an absorber, ``[z1, z2, z1', z2']`` (m, m/s), relative to the
+    mount (Eq. 4.1 rewritten in ``z_i = u_i - u0``).
+
+    Parameters
+    ----------
+    model : IsolatorModel
+        Masses in kg, stiffnesses in N/m, damping in N s/m.
+    """
+    m1, k1, m2, k2, c, c1 = model.m1, model.k1, model.m2, model.k2, model.c, model.c1
+    if not model.has_absorber:
+        A = np.array([[0.0, 1.0], [-k1 / m1, -c1 / m1]])
+        B = np.array([[0.0], [-1.0]])
+        C = A[1:2, :].copy()
+        return A, B, C
+    A = np.array(
+        [
+            [0.0, 0.0, 1.0, 0.0],
+            [0.0, 0.0, 0.0, 1.0],
+            [-(k1 + k2) / m1, k2 / m1, -(c + c1) / m1, c / m1],
+            [k2 / m2, -k2 / m2, c / m2, -c / m2],
+        ]
+    )
+    B = np.array([[0.0], [0.0], [-1.0], [-1.0]])
+    C = A[2:3, :].copy()  # u1'' = z1'' + a0 = (A x)_3
+    return A, B, C
+
+
+def foh_discretize(
+    A: NDArray[np.float64], B: NDArray[np.float64], steps: ArrayLike
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """First-order-hold matrices ``(Phi, G1, G2)`` for each step, from the augmented ``expm``.
+
+    Parameters
+    ----------
+    A : ndarray, shape (n, n)
+        State matrix, 1/s.
+    B : ndarray, shape (n, 1)
+        Input matrix.
+    steps : array_like, shape (m,)
+        Step lengths ``h``, s.
+
+    Returns
+    -------
+    Phi : ndarray, shape (m, n, n)
+    G1 : ndarray, shape (m, n)
+        Response to the input value at the step start.
+    G2 : ndarray, shape (m, n)
+        Response to the input slope over the step (multiply by ``(a0_{j+1} - a0_j)/h``).
+    """
+    h = np.asarray(steps, dtype=float).reshape(-1)
+    n = A.shape[0]
+    M = np.zeros((n + 2, n + 2))
+    M[:n, :n] = A
+    M[:n, n] = B[:, 0]
+    M[n, n + 1] = 1.0
+    E = linalg.expm(h[:, None, None] * M[None, :, :])
+    return E[:, :n, :n], E[:, :n, n], E[:, :n, n + 1]
+
+
+def _group_steps(
+    h: NDArray[np.float64], tmax: float
+) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
+    """Distinct steps, merging those equal to within the rounding of the time points."""
+    tol = 8.0 * np.finfo(float).eps * max(tmax, float(h.max()))
+    keys = np.rint(h / tol)
+    _, first, inverse = np.unique(keys, return_index=True, return_inverse=True)
+    return h[first], inverse.reshape(-1)
+
+
+def _affine_scan(
+    Phi: NDArray[np.float64],
+    G1: NDArray[np.float64],
+    G2: NDArray[np.float64],
+    index: NDArray[np.intp],
+    u: NDArray[np.float64],
+    slope: NDArray[np.float64],
+    n: int,
+) -> NDArray[np.float64]:
+    """States ``x_j``, shape (N+1, n), of ``x_{j+1} = Phi_j x_j + G1_j u_j + G2_j s_j``, x_0 = 0.
+
+    Hillis-Steele prefix scan of the affine maps within chunks of ``_CHUNK`` steps, the state
+    carried between chunks (a loop over chunks, not samples).
+    """
+    n_steps = index.size
+    X = np.zeros((n_steps + 1, n))
+    x = np.zeros(n)
+    for start in range(0, n_steps, _CHUNK):
+        sl = slice(start, min(start + _CHUNK, n_steps))
+        idx = index[sl]
+        P = Phi[idx].copy()
+        G = G1[idx] * u[sl, None] + G2[idx] * slope[sl, None]
+        m = idx.size
+        d = 1
+        while d < m:
+            newG = np.einsum("kij,kj->ki", P[d:], G[:-d]) + G[d:]
+            newP = np.matmul(P[d:], P[:-d])
+            G[d:] = newG
+            P[d:] = newP
+            d *= 2
+        X[start + 1 : start + m + 1] = np.einsum("kij,j->ki", P, x) + G
+        x = X[start + m]
+    return X
+
+
+@dataclass
+class IsolationTimeResponse:
+    """Mount and package acceleration histories and their peak/RMS reduction.
+
+    Attributes
+    ----------
+    timepts : times, s (the input times, subdivided when ``oversample > 1``).
+    mount_accel : mount (support) acceleration ``a0``, m/s^2.
+    package_accel : package absolute acceleration ``u1''``, m/s^2.
+    stroke : package displacement relative to the mount ``u1 - u0``, m.
+    peak_mount, peak_package : largest absolute sample, m/s^2.
+    rms_mount, rms_package : time-weighted RMS (trapezoidal rule on the squared samples), m/s^2.
+    peak_ratio, rms_ratio : package over mount (below 1 means isolation).
+    peak_stroke : largest ``|u1 - u0|``, m (rattle space the mount needs).
+    model : the isolator used.
+    """
+
+    timepts: NDArray[np.float64]
+    mount_accel: NDArray[np.float64]
+    package_accel: NDArray[np.float64]
+    stroke: NDArray[np.float64]
+    peak_mount: float
+    peak_package: float
+    rms_mount: float
+    rms_package: float
+    peak_ratio: float
+    rms_ratio: float
+    peak_stroke: float
+    model: IsolatorModel
+
+
+def _rms(t: NDArray[np.float64], y: NDArray[np.float64]) -> float:
+    return float(math.sqrt(np.trapezoid(y * y, t) / (t[-1] - t[0])))
+
+
+def _ratio(a: float, b: float) -> float:
+    return a / b if b > 0 else math.nan
+
+
+def package_response(
+    model: IsolatorModel, timepts: ArrayLike, mount_accel: ArrayLike, *, oversample: int = 1
+) -> IsolationTimeResponse:
+    """Package acceleration for a mount acceleration linear between samples (exact, FOH).
+
+    Parameters
+    ----------
+    model : IsolatorModel
+        Package, mount and optional absorber (kg, N/m, N s/m).
+    timepts : array_like, shape (N,)
+        Strictly increasing sample times, s; steps may be non-uniform.
+    mount_accel : array_like, shape (N,)
+        Mount acceleration ``a0`` at ``timepts``, m/s^2, taken linear between samples.
+    oversample : int
+        Subdivide every step into this many equal steps (the input stays the same piecewise-
+        linear function) so that peaks between the input samples are resolved.
+
+    Returns
+    -------
+    IsolationTimeResponse
+        Start from rest relative to the mount (``u1 - u0 = 0`` and its rate 0 at ``timepts[0]``).
+    """
+    t = np.asarray(timepts, dtype=float)
+    a0 = np.asarray(mount_accel, dtype=float)
+    if t.ndim != 1 or t.size < 2:
+        raise InputError("need a 1-D array of at least 2 times", where="timepts")
+    if a0.shape != t.shape:
+        raise InputError(f"shape {a0.shape} differs from timepts {t.shape}", where="mount_accel")
+    if not (np.all(np.isfinite(t)) and np.all(np.isfinite(a0))):
+        raise InputError("contains NaN or inf", where="timepts/mount_accel")
+    if not np.all(np.diff(t) > 0):
+        raise InputError("times must be strictly increasing", where="timepts")
+    if not (isinstance(oversample, int | np.integer) and oversample >= 1):
+        raise InputError(f"must be an integer >= 1, got {oversample!r}", where="oversample")
+    if oversample > 1:
+        frac = np.arange(oversample) / oversample
+        h0 = np.diff(t)
+        t = np.concatenate(((t[:-1, None] + h0[:, None] * frac).ravel(), t[-1:]))
+        a0 = np.concatenate(((a0[:-1, None] + np.diff(a0)[:, None] * frac).ravel(), a0[-1:]))
+    A, B, C = state_space(model)
+    h = np.diff(t)
+    h_unique, index = _group_steps(h, float(np.max(np.abs(t))))
+    Phi, G1, G2 = foh_discretize(A, B, h_unique)
+    slope = np.diff(a0) / h
+    X = _affine_scan(Phi, G1, G2, index, a0[:-1], slope, A.shape[0])
+    y = X @ C[0]
+    stroke = X[:, 0]
+    peak_mount = float(np.max(np.abs(a0)))
+    peak_package = float(np.max(np.abs(y)))
+    rms_mount = _rms(t, a0)
+    rms_package = _rms(t, y)
+    return IsolationTimeResponse(
+        timepts=t,
+        mount_accel=a0,
+        package_accel=y,
+        stroke=stroke,
+        peak_mount=peak_mount,
+        peak_package=peak_package,
+        rms_mount=rms_mount,
+        rms_package=rms_package,
+        peak_ratio=_ratio(peak_package, peak_mount),
+        rms_ratio=_ratio(rms_package, rms_mount),
+        peak_stroke=float(np.max(np.abs(stroke))),
+        model=model,
+    )
