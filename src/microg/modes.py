@@ -220,12 +220,21 @@ def effective_mass(
 
 def _modal_mass_unit_peak(structure: Structure, phi: np.ndarray) -> np.ndarray:
     maps = [p.translation for p in structure.points.values()]
-    if structure.samples is not None:
-        samp = structure.samples.translation
+    sample_peak = None
+    samples = structure.samples
+    if samples is not None and hasattr(samples, "displacement"):
+        # sparse-friendly samples (microg.fem.NodeSamples): (p, 3, m) translations
+        sample_peak = np.max(np.abs(samples.displacement(phi)), axis=(0, 1))
+    elif samples is not None:
+        samp = samples.translation
         maps.extend(list(samp.reshape(-1, samp.shape[-1])[None]))
     if maps:
         t = np.concatenate([np.reshape(m, (-1, phi.shape[0])) for m in maps], axis=0)
         peak = np.max(np.abs(t @ phi), axis=0)
+        if sample_peak is not None:
+            peak = np.maximum(peak, sample_peak)
+    elif sample_peak is not None:
+        peak = sample_peak
     else:
         peak = np.max(np.abs(phi), axis=0)
     peak = np.where(peak > 0, peak, 1.0)

@@ -1,0 +1,364 @@
+"""The main job: a station's microgravity environment under crew disturbances.
+
+``run_analysis`` loads a model, discretises it, solves the free-free modes, applies the
+disturbances (exact piecewise-linear modal response, damped modes, rigid-body modes
+included), assesses the acceleration at the observed points against the ISS vibratory
+requirement, and recommends isolation where a point does not comply.  It returns one
+:class:`Analysis` object; the CLI and the HTML report only read it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from microg.assess import Assessment, assess, iss_requirement, report_flat_requirement
+from microg.errors import InputError
+from microg.forces import ForceHistory
+from microg.model import Station
+from microg.modes import Modes, solve_modes
+from microg.response import PointResponse, generalized_force_vector, response_at_points
+from microg.structure import Structure
+from microg.units import G0
+
+__all__ = [
+    "Disturbance",
+    "AnalysisOptions",
+    "IsolationAdvice",
+    "Analysis",
+    "run_analysis",
+    "build_structure",
+    "AXES",
+]
+
+AXES: dict[str, np.ndarray] = {
+    "x": np.array([1.0, 0, 0]),
+    "y": np.array([0, 1.0, 0]),
+    "z": np.array([0, 0, 1.0]),
+}
+
+
+@dataclass(frozen=True)
+class Disturbance:
+    """A force history applied at a named point in a direction.
+
+    Attributes
+    ----------
+    force : ForceHistory
+        Breakpoints (s, N); its own direction, if any, wins over ``direction``.
+    point : str
+        Named point of the model where it acts.
+    direction : ndarray (3,)
+        Unit vector of the force in the station frame.
+    """
+
+    force: ForceHistory
+    point: str
+    direction: np.ndarray
+
+    @property
+    def unit_direction(self) -> np.ndarray:
+        """The direction used: the force's own (CSV) direction if it has one."""
+        d = self.force.direction if self.force.direction is not None else self.direction
+        d = np.asarray(d, float)
+        return d / np.linalg.norm(d)
+
+
+@dataclass(frozen=True)
+class AnalysisOptions:
+    """Everything ``microg analyze`` needs besides the model (SI).
+
+    Attributes
+    ----------
+    disturbances : sequence of Disturbance
+        Applied together (superposed).
+    observe : sequence of str
+        Named points to assess.
+    method : str
+        ``"fem"`` (3-D frame elements) or ``"ritz"`` (the report's planar assumed modes).
+    plane : str
+        ``"xz"`` or ``"yz"`` for ``ritz``.
+    elements_per_beam : int
+        Finite elements per beam (``fem``); assumed functions per beam (``ritz``).
+    zeta : float
+        Modal damping ratio of the elastic modes.
+    max_freq_hz : float
+        Elastic modes up to this frequency are kept (the rigid-body modes always).
+    duration : float
+        Length of the output record, s.
+    dt : float
+        Output sample interval, s.
+    requirement : str
+        ``"iss"`` (ISS vibratory requirement) or ``"flat"`` (the report's 1e-5 g).
+    package_mass : float
+        Experiment package mass for the isolation advice, kg.
+    absorber_mu : float or None
+        Absorber mass ratio for the isolation advice (None: spring only).
+    """
+
+    disturbances: Sequence[Disturbance]
+    observe: Sequence[str]
+    method: str = "fem"
+    plane: str = "xz"
+    elements_per_beam: int = 10
+    zeta: float = 0.005
+    max_freq_hz: float = 10.0
+    duration: float = 200.0
+    dt: float = 0.01
+    requirement: str = "iss"
+    package_mass: float = 1000.0 * 0.45359237
+    absorber_mu: float | None = None
+
+
+@dataclass(frozen=True)
+class IsolationAdvice:
+    """Isolation recommendation for one observed point.
+
+    Attributes
+    ----------
+    point : str
+    needed : bool
+        False when the point complies without isolation.
+    band_hz : tuple of float
+        Lowest and highest band edges where the requirement is exceeded, Hz.
+    target_ma : float
+        Largest acceleration magnification that brings every exceeding band to its limit.
+    design : object or None
+        :class:`microg.isolation.design.MountDesign` (stiffness, natural frequency, sag).
+    note : str
+    """
+
+    point: str
+    needed: bool
+    band_hz: tuple[float, float] | None
+    target_ma: float | None
+    design: object | None
+    note: str
+
+
+@dataclass(frozen=True)
+class Analysis:
+    """Result of :func:`run_analysis`.
+
+    Attributes
+    ----------
+    model : str
+        Model name.
+    options : AnalysisOptions
+    structure : Structure
+    modes : Modes
+        All computed modes (``used`` marks those in the response).
+    used : ndarray of bool
+        Modes kept for the response (rigid + elastic up to ``max_freq_hz``).
+    responses : dict of str to PointResponse
+        Motion of each observed point (3 axes, SI).
+    assessments : dict of str to Assessment
+    isolation : dict of str to IsolationAdvice
+    timepts : ndarray
+        Output times, s.
+    """
+
+    model: str
+    options: AnalysisOptions
+    structure: Structure
+    modes: Modes
+    used: np.ndarray
+    responses: dict[str, PointResponse]
+    assessments: dict[str, Assessment]
+    isolation: dict[str, IsolationAdvice]
+    timepts: np.ndarray
+    warnings: list[str] = field(default_factory=list)
+
+    def to_dict(self) -> dict:
+        """The ``microg analyze --json`` contract."""
+        modes = self.modes.to_dict()
+        for row, used in zip(modes["modes"], self.used, strict=True):
+            row["used"] = bool(used)
+        obs = {}
+        for name, a in self.assessments.items():
+            d = a.to_dict()
+            d["isolation"] = _advice_dict(self.isolation[name])
+            obs[name] = d
+        return {
+            "model": self.model,
+            "method": self.structure.method,
+            "plane": self.structure.plane,
+            "modes": modes,
+            "disturbances": [
+                {
+                    "name": d.force.name,
+                    "at": d.point,
+                    "direction": d.unit_direction,
+                    "peak_force_N": float(np.max(np.abs(d.force.force))),
+                    "impulse_Ns": float(d.force.impulse()),
+                }
+                for d in self.options.disturbances
+            ],
+            "damping": self.options.zeta,
+            "requirement": self.options.requirement,
+            "record": {"duration_s": self.options.duration, "dt_s": self.options.dt},
+            "observations": obs,
+            "complies": all(a.complies for a in self.assessments.values()),
+            "warnings": list(self.warnings),
+        }
+
+
+def _advice_dict(adv: IsolationAdvice) -> dict:
+    out = {
+        "needed": adv.needed,
+        "band_hz": adv.band_hz,
+        "target_Ma": adv.target_ma,
+        "note": adv.note,
+        "design": None,
+    }
+    d = adv.design
+    if d is not None:
+        out["design"] = {
+            k: getattr(d, k)
+            for k in (
+                "k1",
+                "k1_lbf_per_in",
+                "omega_n",
+                "freq_hz_n",
+                "achieved_Ma",
+                "sag_1g",
+                "mu",
+                "k",
+            )
+            if hasattr(d, k)
+        }
+        out["design"]["units"] = "k1 N/m, omega_n rad/s, freq_hz_n Hz, sag_1g m"
+    return out
+
+
+def build_structure(station: Station, method: str, plane: str, n: int) -> Structure:
+    """Discretise ``station`` by ``method`` ("fem": n elements per beam; "ritz": n functions)."""
+    if method == "fem":
+        from microg.fem import build_fem
+
+        return build_fem(station, elements_per_beam=n)
+    if method == "ritz":
+        from microg.ritz import build_ritz
+
+        return build_ritz(station, plane, n, gravity_gradient=False)
+    raise InputError(f"unknown method {method!r}", where="--method", fix="use fem or ritz")
+
+
+def _advise(name: str, a: Assessment, opts: AnalysisOptions) -> IsolationAdvice:
+    from microg.isolation.design import design_mount
+
+    if a.complies:
+        return IsolationAdvice(name, False, None, None, None, "complies without isolation")
+    to = a.third_octave
+    margin = to.margin.min(axis=0)
+    bad = np.isfinite(margin) & (margin < 1.0)
+    if not np.any(bad):
+        return IsolationAdvice(
+            name,
+            True,
+            None,
+            None,
+            None,
+            "exceeds the peak limit only: a passive mount cannot help a transient's peak "
+            "without knowing its spectrum",
+        )
+    lo = float(to.lower_hz[bad].min())
+    hi = float(to.upper_hz[bad].max())
+    target = float(max(margin[bad].min(), 1e-6))
+    note = (
+        f"bands {lo:.3g}-{hi:.3g} Hz exceed the requirement; the mount must attenuate them by "
+        f"{1 / target:.3g}x (M_a <= {target:.3g})"
+    )
+    try:
+        design = design_mount(
+            opts.package_mass,
+            (2 * np.pi * lo, 2 * np.pi * hi),
+            min(target, 1.0),
+            mu=opts.absorber_mu,
+        )
+    except InputError as exc:
+        return IsolationAdvice(name, True, (lo, hi), target, None, f"{note}; no design: {exc}")
+    return IsolationAdvice(name, True, (lo, hi), target, design, note)
+
+
+def run_analysis(
+    station: Station,
+    opts: AnalysisOptions,
+    *,
+    progress: Callable[[str], None] | None = None,
+) -> Analysis:
+    """Run the main job on ``station`` (see the module docstring).
+
+    Parameters
+    ----------
+    station : Station
+    opts : AnalysisOptions
+    progress : callable, optional
+        Called with a stage name as each stage starts (for a progress bar).
+    """
+    step = progress or (lambda _s: None)
+    if not opts.disturbances:
+        raise InputError("no disturbance", where="--force", fix="give at least one --force")
+    if opts.dt <= 0 or opts.duration <= opts.dt:
+        raise InputError("need 0 < dt < duration", where="--dt/--duration")
+    step("structure")
+    structure = build_structure(station, opts.method, opts.plane, opts.elements_per_beam)
+    points = {name: structure.point(name) for name in opts.observe}
+    forces_at = {d.point: structure.point(d.point) for d in opts.disturbances}
+    step("modes")
+    n_req = None
+    if structure.is_sparse:
+        n_req = min(structure.n_dof - 1, 60)
+    modes = solve_modes(structure, n_req)
+    used = modes.rigid | (modes.freq_hz <= opts.max_freq_hz)
+    warnings = []
+    if structure.is_sparse and not modes.rigid[-1] and modes.freq_hz[-1] <= opts.max_freq_hz:
+        warnings.append(
+            f"only {modes.n_modes} modes computed; the highest ({modes.freq_hz[-1]:.3g} Hz) is "
+            f"below --max-freq {opts.max_freq_hz:g} Hz"
+        )
+    m = modes.subset(np.nonzero(used)[0])
+    zeta = np.where(m.rigid, 0.0, opts.zeta)
+    step("response")
+    timepts = np.arange(0.0, opts.duration + 0.5 * opts.dt, opts.dt)
+    maps = {n: p.translation for n, p in points.items()}
+    responses: dict[str, PointResponse] = {}
+    for d in opts.disturbances:
+        b = generalized_force_vector(forces_at[d.point].translation, d.unit_direction)
+        r = response_at_points(m.omega, zeta, m.phi, maps, d.force, b, timepts)
+        for name, pr in r.items():
+            if name in responses:
+                old = responses[name]
+                responses[name] = PointResponse(
+                    name,
+                    timepts,
+                    old.displacement + pr.displacement,
+                    old.velocity + pr.velocity,
+                    old.acceleration + pr.acceleration,
+                )
+            else:
+                responses[name] = pr
+    step("assessment")
+    req = iss_requirement() if opts.requirement == "iss" else report_flat_requirement()
+    assessments = {n: assess(timepts, r.acceleration, req) for n, r in responses.items()}
+    step("isolation")
+    advice = {n: _advise(n, a, opts) for n, a in assessments.items()}
+    return Analysis(
+        model=station.name,
+        options=opts,
+        structure=structure,
+        modes=modes,
+        used=used,
+        responses=responses,
+        assessments=assessments,
+        isolation=advice,
+        timepts=timepts,
+        warnings=warnings,
+    )
+
+
+def peak_g(response: PointResponse) -> float:
+    """Peak magnitude of a point's acceleration, g."""
+    return float(np.max(np.linalg.norm(response.acceleration, axis=0)) / G0)
