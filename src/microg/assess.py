@@ -580,8 +580,10 @@ def plot_psd(
     """PSD in g^2/Hz against frequency (log-log); returns a Figure."""
     fig, ax = _figure(title or f"PSD ({spectrum.method})")
     f = spectrum.freq_hz[1:]
+    top = max(float(np.max(spectrum.psd[:, 1:])) / G0**2, 1e-300)
     for name, row in zip(axes, spectrum.psd, strict=False):
         ax.loglog(f, np.maximum(row[1:] / G0**2, 1e-300), label=name, lw=0.8)
+    ax.set_ylim(top * 1e-12, top * 10)  # 12 decades: below that is rounding noise
     ax.set_xlabel("frequency [Hz]")
     ax.set_ylabel("PSD [g^2/Hz]")
     ax.grid(True, which="both", alpha=0.3)

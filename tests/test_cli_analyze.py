@@ -1,0 +1,179 @@
+"""``microg analyze``: contract, force specs, bad input, and the report in headless Chromium."""
+
+from __future__ import annotations
+
+import json
+import re
+import shutil
+import subprocess
+import tempfile
+from pathlib import Path
+
+import pytest
+
+from microg.cli import main
+
+FAST = ["--duration", "40", "--dt", "0.02", "--no-progress"]
+
+
+def _run(capsys, args: list[str]) -> tuple[int, str, str]:
+    rc = main(args)
+    out, err = capsys.readouterr()
+    return rc, out, err
+
+
+@pytest.fixture(scope="module")
+def default_run(tmp_path_factory) -> Path:
+    out = tmp_path_factory.mktemp("an") / "a"
+    assert (
+        main(["analyze", "--out", str(out), "--observe", "lab", "--observe", "keel-tip", *FAST])
+        == 0
+    )
+    return out
+
+
+def test_default_model_runs_and_writes(default_run: Path) -> None:
+    names = sorted(p.name for p in default_run.iterdir())
+    assert "report.html" in names and "results.json" in names and "modes.png" in names
+    d = json.loads((default_run / "results.json").read_text())
+    assert d["model"] == "ioc"
+    assert {"modes", "observations"} <= set(d)
+    assert set(d["modes"]) >= {"method", "modes"}
+    assert sum(m["rigid"] for m in d["modes"]["modes"]) == 6  # 3-D free-free station
+    for name in ("lab", "keel-tip"):
+        o = d["observations"][name]
+        assert {"peak_accel_g", "rms_accel_g", "third_octave", "complies"} <= set(o)
+        assert len(o["third_octave"]["center_hz"]) == len(o["third_octave"]["limit_g"])
+
+
+@pytest.mark.parametrize(
+    "spec", ["crew-pushoff", "crew-pushoff:f0=40lbf,t1=0.5s", "hand-pushoff-mean", "CSV"]
+)
+def test_force_specs(tmp_path: Path, capsys, spec: str) -> None:
+    if spec == "CSV":
+        csv = tmp_path / "push.csv"
+        csv.write_text("time [s],force [lbf]\n0,0\n1,25\n1.01,0\n13,0\n13.01,-25\n14,0\n")
+        spec = str(csv)
+    rc, out, err = _run(
+        capsys, ["analyze", "--force", spec, "--out", str(tmp_path / "o"), "--json", *FAST]
+    )
+    assert rc == 0, err
+    d = json.loads(out)
+    assert d["observations"]["lab"]["peak_accel_g"] > 0
+
+
+def test_f0_scales_peak(tmp_path: Path, capsys) -> None:
+    # linear structure: 40 lbf gives 40/25 of the 25-lbf peak (t1 unchanged)
+    rc, out1, _ = _run(capsys, ["analyze", "--out", str(tmp_path / "a"), "--json", *FAST])
+    rc, out2, _ = _run(
+        capsys,
+        [
+            "analyze",
+            "--force",
+            "crew-pushoff:f0=40lbf",
+            "--out",
+            str(tmp_path / "b"),
+            "--json",
+            *FAST,
+        ],
+    )
+    p1 = json.loads(out1)["observations"]["lab"]["peak_accel_g"]
+    p2 = json.loads(out2)["observations"]["lab"]["peak_accel_g"]
+    assert p2 == pytest.approx(p1 * 40 / 25, rel=1e-9)
+
+
+@pytest.mark.parametrize(
+    ("args", "needle"),
+    [
+        (["--observe", "nowhere"], "known points: "),
+        (["--at", "nowhere"], "known points: "),
+        (["--force", "teleport"], "--force"),
+        (["--damping", "1.5"], "--damping"),
+        (["--damping", "-0.1"], "--damping"),
+        (["--dt", "0"], "--dt"),
+        (["--method", "bem"], "--method"),
+        (["no-such-model"], "no-such-model"),
+        (["--direction", "sideways"], "--direction"),
+    ],
+)
+def test_bad_input(tmp_path: Path, capsys, args, needle) -> None:
+    out = tmp_path / "never"
+    rc, stdout, err = _run(capsys, ["analyze", *FAST, *args, "--out", str(out)])
+    assert rc == 2
+    assert needle in err and err.count("\n") == 1 and "Traceback" not in err
+    assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    ("content", "needle"),
+    [
+        ("time [s],force [lbf]\n0,0\n1,25\n0.5,0\n", "line 4"),
+        ("time [s],force [lbf]\n0,0\n1,nan\n", "line 3"),
+        ("time [s]\n0\n1\n", "force"),
+        ("time [s],force [m]\n0,0\n1,1\n", "force"),
+    ],
+)
+def test_bad_csv(tmp_path: Path, capsys, content: str, needle: str) -> None:
+    csv = tmp_path / "bad.csv"
+    csv.write_text(content)
+    out = tmp_path / "never"
+    rc, _, err = _run(capsys, ["analyze", "--force", str(csv), "--out", str(out), *FAST])
+    assert rc == 2
+    assert "bad.csv" in err and needle in err and err.count("\n") == 1
+    assert not out.exists()
+
+
+CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
+
+PROBE = """
+<script>
+window.addEventListener("load", () => {
+  const imgs = Array.from(document.images);
+  const ok = imgs.filter((im) => im.complete && im.naturalWidth > 0).length;
+  document.body.setAttribute("data-images", imgs.length);
+  document.body.setAttribute("data-decoded", ok);
+});
+</script>
+"""
+
+
+@pytest.mark.browser
+@pytest.mark.skipif(
+    CHROMIUM is None, reason="headless Chromium not installed (.ci/run installs it)"
+)
+def test_report_in_headless_chromium(default_run: Path) -> None:
+    # open a copy of report.html with a probe appended (the report itself stays untouched):
+    # every <img> must have decoded (naturalWidth > 0) and the page must log nothing
+    html = (default_run / "report.html").read_text()
+    n_png = html.count("data:image/png;base64,")
+    assert n_png == 9  # modes + 4 per observed point (2 points)
+    with tempfile.TemporaryDirectory() as tmp:
+        page = Path(tmp) / "page.html"
+        page.write_text(html + PROBE)
+        proc = subprocess.run(
+            [
+                CHROMIUM,
+                "--headless",
+                "--no-sandbox",
+                "--disable-gpu",
+                "--disable-quic",
+                "--no-first-run",
+                "--disable-background-networking",
+                "--disable-component-update",
+                "--disable-sync",
+                f"--user-data-dir={tmp}/profile",
+                "--enable-logging=stderr",
+                "--v=0",
+                "--virtual-time-budget=5000",
+                "--dump-dom",
+                page.as_uri(),
+            ],
+            capture_output=True,
+            text=True,
+            timeout=120,
+        )
+    m = re.search(r'data-images="(\d+)" data-decoded="(\d+)"', proc.stdout)
+    assert m is not None, proc.stderr[-2000:]
+    assert int(m.group(1)) == n_png and int(m.group(2)) == n_png
+    console = [ln for ln in proc.stderr.splitlines() if "CONSOLE" in ln]
+    assert console == []
