@@ -48,11 +48,12 @@ def test_files_written(tmp_path: Path, capsys) -> None:
     assert sorted(p.name for p in out.iterdir()) == [
         "figure3.png",
         "figure4.png",
+        "lab-response.png",
         "report.html",
         "results.json",
     ]
     html = (out / "report.html").read_text()
-    assert html.count("data:image/png;base64,") == 2  # figures embedded: self-contained
+    assert html.count("data:image/png;base64,") == 3  # figures embedded: self-contained
     assert "Errata" in html
     assert (out / "figure3.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert "report written" in stdout

@@ -13,7 +13,7 @@ from matplotlib.figure import Figure  # noqa: E402
 
 from microg.reproduce import CurveSet  # noqa: E402
 
-__all__ = ["figure3", "figure4", "png_bytes", "png_data_uri"]
+__all__ = ["figure3", "figure4", "point_response_figure", "png_bytes", "png_data_uri"]
 
 
 def _curves(curves: CurveSet, which: str, title: str, ylabel: str) -> Figure:
@@ -38,6 +38,25 @@ def figure3(curves: CurveSet) -> Figure:
 def figure4(curves: CurveSet) -> Figure:
     """Figure 4: dimensionless acceleration A(t) (Eq. 2.19) for several w."""
     return _curves(curves, "a", "Figure 4 - acceleration functions A(t), Eq. 2.19", "A(t)")
+
+
+def point_response_figure(responses: dict, z_e_ft: float, z_a_ft: float) -> Figure:
+    """Acceleration at z_e from the crew force at z_a per case (Eq. 2.20b), in micro-g."""
+    fig, axes = plt.subplots(2, 2, figsize=(9.5, 6.0), layout="constrained", sharex=True)
+    for ax, (case, r) in zip(axes.ravel(), responses.items(), strict=False):
+        for j, a in enumerate(r.accel_modes, 1):
+            ax.plot(r.timepts, a / 9.80665 * 1e6, lw=0.9, label=f"mode {j}")
+        ax.plot(r.timepts, r.accel / 9.80665 * 1e6, "k", lw=1.1, label="sum")
+        ax.set_title(case, fontsize=10)
+        ax.grid(alpha=0.3)
+        ax.set_ylabel("micro-g")
+    axes[0, 0].legend(fontsize=8)
+    for ax in axes[1]:
+        ax.set_xlabel("time t (s)")
+    fig.suptitle(
+        f"Acceleration at z_e = {z_e_ft:.4g} ft, crew force at z_a = {z_a_ft:.4g} ft (Eq. 2.20b)"
+    )
+    return fig
 
 
 def png_bytes(fig: Figure, dpi: int = 110) -> bytes:

@@ -23,8 +23,10 @@ def environment() -> Environment:
     )
 
 
-def render_reproduction(rep: Reproduction, fig3_uri: str, fig4_uri: str) -> str:
-    """HTML of the reproduction with Figures 3 and 4 as data URIs."""
+def render_reproduction(
+    rep: Reproduction, fig3_uri: str, fig4_uri: str, response_uri: str | None = None
+) -> str:
+    """HTML of the reproduction with Figures 3, 4 and the point response as data URIs."""
     data = to_jsonable(rep.contract())
     tmpl = environment().get_template("reproduce.html")
     return tmpl.render(
@@ -37,5 +39,6 @@ def render_reproduction(rep: Reproduction, fig3_uri: str, fig4_uri: str) -> str:
         rigid_g=next(iter(rep.table4.values())).rigid_translation_accel_g,
         fig3=fig3_uri,
         fig4=fig4_uri,
+        response_fig=response_uri,
         amax=list(zip(rep.curves.omega.tolist(), rep.curves.amax.tolist(), strict=True)),
     )

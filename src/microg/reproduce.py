@@ -30,6 +30,8 @@ __all__ = [
     "Table4Case",
     "CurveSet",
     "Reproduction",
+    "ReportPointResponse",
+    "report_point_response",
     "reproduce",
 ]
 
@@ -227,6 +229,7 @@ class Reproduction:
     curves: CurveSet
     errata: list[ErrataEntry]
     model_mass: dict[str, dict[str, float]] = field(default_factory=dict)
+    point_response: dict[str, ReportPointResponse] = field(default_factory=dict)
 
     def contract(self) -> dict:
         """The ``--json`` contract: ``appendix_c`` and ``table4`` keyed by case."""
@@ -453,5 +456,78 @@ def reproduce(
     )
     from microg.errata import build_errata
 
-    rep = Reproduction(opts, appendix, table4, curves, [], model_mass)
-    return Reproduction(opts, appendix, table4, curves, build_errata(rep), model_mass)
+    t_resp = np.linspace(0.0, 100.0, 2001)
+    point_response = {}
+    for case, ac in appendix.items():
+        psi_e = np.array([1.0, opts.z_e / l_k, 0.0, 0.0])  # points on the rigid main body
+        psi_a = np.array([1.0, opts.z_a / l_k, 0.0, 0.0])
+        point_response[case] = report_point_response(
+            ac.phi, ac.modal_mass * SLUG, np.sqrt(ac.omega2), psi_e, psi_a, opts.crew, t_resp
+        )
+    rep = Reproduction(opts, appendix, table4, curves, [], model_mass, point_response)
+    return Reproduction(
+        opts, appendix, table4, curves, build_errata(rep), model_mass, point_response
+    )
+
+
+@dataclass(frozen=True)
+class ReportPointResponse:
+    """Response at an observation point to the crew force at another (Eqs. 2.20a-b).
+
+    Attributes
+    ----------
+    timepts : ndarray (nt,)
+        s.
+    displacement_modes, accel_modes : ndarray (nm, nt)
+        Each elastic mode's contribution, m and m/s^2.
+    displacement, accel : ndarray (nt,)
+        Their sums (the report's modal superposition), m and m/s^2.
+    peak_accel_modes : ndarray (nm,)
+        Exact peak of each mode's contribution (Eq. 3.1), m/s^2.
+    """
+
+    timepts: np.ndarray
+    displacement_modes: np.ndarray
+    accel_modes: np.ndarray
+    displacement: np.ndarray
+    accel: np.ndarray
+    peak_accel_modes: np.ndarray
+
+
+def report_point_response(
+    phi: np.ndarray,
+    modal_mass: np.ndarray,
+    omega: np.ndarray,
+    psi_e: np.ndarray,
+    psi_a: np.ndarray,
+    crew: CrewPushoff,
+    timepts: np.ndarray,
+) -> ReportPointResponse:
+    """Closed-form response at P_e to the crew force at P_a (Eqs. 2.20a, 2.20b, 3.1).
+
+    ``u = sum_j (phi_j . psi(P_e)) (phi_j . psi(P_a)) U_j(t) f0/(w_j^3 t1 M_jj)`` and the
+    same with ``A_j(t) f0/(w_j t1 M_jj)`` for the acceleration.
+
+    Parameters
+    ----------
+    phi : ndarray (n, nm)
+        Elastic eigenvectors, one per column (any scaling).
+    modal_mass : ndarray (nm,)
+        ``phi_j^T m phi_j``, kg (consistent with ``phi``).
+    omega : ndarray (nm,)
+        rad/s (> 0).
+    psi_e, psi_a : ndarray (n,)
+        Admissible functions at the observation and force points (Eq. 2.1); for the report's
+        model ``[1, z/l_k, psi3(z), psi4(y)]`` (psi3 = psi4 = 0 on the rigid main body).
+    crew : CrewPushoff
+    timepts : ndarray (nt,)
+        s.
+    """
+    part = (phi.T @ psi_e) * (phi.T @ psi_a)  # (nm,)
+    w = omega[:, None]
+    u = displacement_u(w, timepts, crew) * (crew.f0 / (w**3 * crew.t1 * modal_mass[:, None]))
+    a = acceleration_a(w, timepts, crew) * (crew.f0 / (w * crew.t1 * modal_mass[:, None]))
+    u = part[:, None] * u
+    a = part[:, None] * a
+    peak = np.abs(part) * crew.f0 * accel_amax(omega, crew) / (omega * crew.t1 * modal_mass)
+    return ReportPointResponse(timepts, u, a, u.sum(axis=0), a.sum(axis=0), peak)

@@ -86,12 +86,14 @@ def reproduce(
 ) -> None:
     """Recompute the seed report's Appendix C, Table 4 and Figures 3-4, with an errata.
 
-    Writes OUT/report.html (self-contained), OUT/figure3.png, OUT/figure4.png and
-    OUT/results.json; every computed value follows the crew-force and point options.
+    Writes OUT/report.html (self-contained), OUT/figure3.png, OUT/figure4.png,
+    OUT/lab-response.png (Eq. 2.20b at z_e) and OUT/results.json; every computed value
+    follows the crew-force and point options.
     """
     from microg.crew import CrewPushoff
+    from microg.ioc import FT
     from microg.ioutil import atomic_directory, dumps
-    from microg.plots import figure3, figure4, png_bytes, png_data_uri
+    from microg.plots import figure3, figure4, png_bytes, png_data_uri, point_response_figure
     from microg.report import render_reproduction
     from microg.reproduce import ReproduceOptions
     from microg.reproduce import reproduce as run
@@ -106,15 +108,18 @@ def reproduce(
             rep.curves,
             rep.errata,
             rep.model_mass,
+            {k: v for k, v in rep.point_response.items() if k in cases},
         )
     fig3 = png_bytes(figure3(rep.curves))
     fig4 = png_bytes(figure4(rep.curves))
-    html = render_reproduction(rep, png_data_uri(fig3), png_data_uri(fig4))
+    fig_resp = png_bytes(point_response_figure(rep.point_response, z_e / FT, z_a / FT))
+    html = render_reproduction(rep, png_data_uri(fig3), png_data_uri(fig4), png_data_uri(fig_resp))
     text = dumps(rep.contract())
 
     def fill(tmp: Path) -> None:
         (tmp / "figure3.png").write_bytes(fig3)
         (tmp / "figure4.png").write_bytes(fig4)
+        (tmp / "lab-response.png").write_bytes(fig_resp)
         (tmp / "report.html").write_text(html, encoding="utf-8")
         (tmp / "results.json").write_text(text, encoding="utf-8")
 
