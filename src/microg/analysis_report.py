@@ -44,6 +44,22 @@ def _modes_figure(result: Analysis) -> Figure:
     return fig
 
 
+def _isolation_figure(result: Analysis, name: str) -> Figure:
+    adv = result.isolation[name]
+    r = result.responses[name]
+    axis = int(np.argmax(np.max(np.abs(r.acceleration), axis=1)))
+    fig = Figure(figsize=(7.5, 4.0), layout="constrained")
+    ax = fig.add_subplot()
+    ax.plot(r.timepts, r.acceleration[axis] / 9.80665 * 1e6, lw=0.8, label="mount (station)")
+    ax.plot(r.timepts, adv.package_accel[axis] / 9.80665 * 1e6, lw=0.9, label="isolated package")
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel(f"acceleration, {'xyz'[axis]} [micro-g]")
+    ax.set_title(f"What the package feels at {name} on the advised mount")
+    ax.grid(True, alpha=0.3)
+    ax.legend()
+    return fig
+
+
 def figures(result: Analysis) -> dict[str, bytes]:
     """PNG bytes of every figure, keyed by file name."""
     out = {"modes.png": png_bytes(_modes_figure(result))}
@@ -58,6 +74,9 @@ def figures(result: Analysis) -> dict[str, bytes]:
         out[f"{s}-third-octave.png"] = png_bytes(
             plot_third_octave(a, title=f"1/3-octave band RMS at {name} vs {a.requirement}")
         )
+        adv = result.isolation[name]
+        if adv.package_accel is not None:
+            out[f"{s}-isolated.png"] = png_bytes(_isolation_figure(result, name))
         out[f"{s}-integrated.png"] = png_bytes(
             plot_integrated_acceleration(
                 r.timepts,
@@ -76,16 +95,12 @@ def render_analysis(result: Analysis, figs: dict[str, bytes]) -> str:
     obs = []
     for name in result.assessments:
         s = _safe(name)
+        keys = ["time", "psd", "third-octave", "integrated", "isolated"]
         obs.append(
             {
                 "name": name,
                 "data": data["observations"][name],
-                "figs": [
-                    uris[f"{s}-time.png"],
-                    uris[f"{s}-psd.png"],
-                    uris[f"{s}-third-octave.png"],
-                    uris[f"{s}-integrated.png"],
-                ],
+                "figs": [uris[f"{s}-{k}.png"] for k in keys if f"{s}-{k}.png" in uris],
             }
         )
     return (

@@ -255,8 +255,9 @@ def _summary(result, path: Path) -> None:  # type: ignore[no-untyped-def]
         if adv.design is not None:
             d = adv.design
             click.echo(
-                f"    mount: k1 <= {d.k1:.4g} N/m ({d.k1_lbf_per_in:.4g} lbf/in), "
-                f"natural frequency {d.freq_hz_n:.3g} Hz, sag under 1 g {d.sag_1g:.3g} m"
+                f"    report's rule (Sec. 4.2): k1 <= {d.k1:.4g} N/m "
+                f"({d.k1_lbf_per_in:.4g} lbf/in), natural frequency {d.freq_hz_n:.3g} Hz, "
+                f"sag under 1 g {d.sag_1g:.3g} m"
             )
     for w in result.warnings:
         click.echo(f"  warning: {w}")

@@ -1,0 +1,139 @@
+"""Passive mount search against a measured (or computed) acceleration spectrum.
+
+The report's design rule (Section 4.2, :func:`microg.isolation.design.design_mount`) bounds
+M_a over the band where a requirement is exceeded; it ignores the mount's own resonance,
+which a broadband transient (a crew push-off) excites below that band, where the ISS limit is
+strictest.  :func:`search_mount` screens spring-damper mounts on the whole spectrum: the
+package's PSD is ``|T(f)|^2`` times the mount's (linear, time-invariant system), band RMS per
+1/3-octave band against the limit, and returns the stiffest mount that complies.  The caller
+verifies the choice with the exact time-domain response
+(:func:`microg.isolation.timedomain.package_response`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from microg.assess import Requirement, Spectrum, band_rms
+from microg.units import G0
+
+__all__ = ["mount_transmissibility", "MountChoice", "search_mount"]
+
+
+def mount_transmissibility(
+    k1: np.ndarray | float, c1: np.ndarray | float, m1: float, omega: np.ndarray
+) -> np.ndarray:
+    """Absolute transmissibility U1/U0 of a spring-damper mount (no absorber), complex.
+
+    ``T = (k1 + i c1 w) / (k1 - m1 w^2 + i c1 w)``; with ``c1 = 0`` this is Eq. 4.3 with
+    ``m2 = 0``.
+
+    Parameters
+    ----------
+    k1 : float or ndarray
+        Mount stiffness, N/m.
+    c1 : float or ndarray
+        Mount damping, N s/m.
+    m1 : float
+        Package mass, kg.
+    omega : ndarray
+        Circular frequency, rad/s.
+    """
+    num = k1 + 1j * c1 * omega
+    return num / (k1 - m1 * omega**2 + 1j * c1 * omega)
+
+
+@dataclass(frozen=True)
+class MountChoice:
+    """Result of :func:`search_mount`.
+
+    Attributes
+    ----------
+    found : bool
+        A screened mount complies in every band.
+    k1 : float
+        Stiffness of the chosen mount (the stiffest compliant one, else the best), N/m.
+    zeta1 : float
+        Its damping ratio ``c1 / (2 sqrt(k1 m1))``.
+    c1 : float
+        N s/m.
+    min_margin : float
+        Smallest limit / band RMS over axes and bands (>= 1 means compliance).
+    freq_hz_n : float
+        Mount natural frequency, Hz.
+    screened : int
+        Number of (k1, zeta1) pairs screened.
+    """
+
+    found: bool
+    k1: float
+    zeta1: float
+    c1: float
+    min_margin: float
+    freq_hz_n: float
+    screened: int
+
+
+def search_mount(
+    spectrum: Spectrum,
+    requirement: Requirement,
+    mass: float,
+    k_max: float,
+    *,
+    zetas: tuple[float, ...] = (0.0, 0.05, 0.1, 0.2, 0.3, 0.5, 0.7, 1.0),
+    decades: float = 4.0,
+    n_k: int = 81,
+) -> MountChoice:
+    """Stiffest spring-damper mount whose package spectrum meets ``requirement`` everywhere.
+
+    Parameters
+    ----------
+    spectrum : Spectrum
+        One-sided PSD of the mount acceleration, per axis ((m/s^2)^2/Hz).
+    requirement : Requirement
+        Band limits (g).
+    mass : float
+        Package mass, kg.
+    k_max : float
+        Stiffest mount to consider, N/m (e.g. the report's rule's answer); the search spans
+        ``decades`` below it.
+    zetas : tuple of float
+        Mount damping ratios to screen.
+    decades : float
+        Width of the log-spaced stiffness range.
+    n_k : int
+        Number of stiffness values.
+    """
+    omega = 2 * np.pi * spectrum.freq_hz
+    keep = requirement.bands.lower_hz < spectrum.nyquist_hz
+    limit = requirement.limit_g[keep]
+    best = None
+    k_grid = k_max * np.logspace(-decades, 0.0, n_k)
+    for zeta1 in zetas:
+        for k1 in k_grid:
+            c1 = 2 * zeta1 * np.sqrt(k1 * mass)
+            t2 = np.abs(mount_transmissibility(k1, c1, mass, omega)) ** 2
+            spec = Spectrum(
+                spectrum.freq_hz, spectrum.psd * t2, spectrum.df_hz, spectrum.nyquist_hz, "screen"
+            )
+            rms_g = band_rms(spec, requirement.bands).rms / G0
+            with np.errstate(divide="ignore"):
+                margin = float(
+                    np.min(np.where(rms_g > 0, limit / np.maximum(rms_g, 1e-300), np.inf))
+                )
+            cand = (margin >= 1.0, k1 if margin >= 1.0 else margin, k1, zeta1, c1, margin)
+            if best is None or cand[:2] > best[:2]:
+                best = cand
+    assert best is not None
+    found, _, k1, zeta1, c1, margin = best
+    return MountChoice(
+        found=bool(found),
+        k1=float(k1),
+        zeta1=float(zeta1),
+        c1=float(c1),
+        min_margin=margin,
+        freq_hz_n=float(np.sqrt(k1 / mass) / (2 * np.pi)),
+        screened=len(zetas) * n_k,
+    )
