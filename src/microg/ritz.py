@@ -34,6 +34,8 @@ __all__ = [
     "planar_coordinates",
     "assemble",
     "build_ritz",
+    "point_maps",
+    "sample_points",
     "gravity_gradient_stiffness",
     "PLANES",
 ]
