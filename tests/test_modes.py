@@ -71,3 +71,28 @@ def test_ioc_gravity_gradient_leaves_one_rigid_mode() -> None:
     modes = solve_modes(s)
     assert modes.n_rigid == 1
     assert 1e-3 < modes.omega[1] < 3e-3  # the librational mode, ~sqrt(3) w0
+
+
+@pytest.mark.parametrize("k", [1.0, 1e4, 1e5])
+def test_soft_restraint_is_not_called_rigid(k: float) -> None:
+    # a two-mass chain with a tiny ground spring (gravity-gradient-like, 3.6e-6 N/m): the
+    # soft mode is sqrt(k_g / (m1 + m2)) to O(k_g/k); a whole-matrix norm test would call it
+    # rigid (exactly 0) once k_g/k < 1e-9. The row-wise test resolves restraints down to
+    # RIGID_TOL = 1e-12 of a row's stiffness (k_g/2k = 1.8e-11 at k = 1e5); exact rigid
+    # vectors of the frame models score ~1e-16. Reference: the two-mass closed form
+    kg = 3.6e-6
+    stiff = np.array([[k + kg, -k], [-k, k]])
+    mass = np.eye(2)
+    for cand in (None, np.ones((2, 1))):
+        omega, _, rigid = solve_dense(mass, stiff, cand)
+        assert not rigid.any()
+        assert omega[0] == pytest.approx(np.sqrt(kg / 2), rel=1e-6)
+
+
+def test_many_ritz_functions_keep_the_libration_mode() -> None:
+    # gravity gradient restrains the rotation coordinate; with 16 functions per beam the
+    # elastic stiffness is ~1e12 times larger, and the libration mode must still come out
+    s = build_ritz(load_station("ioc"), "xz", 16, gravity_gradient=True)
+    modes = solve_modes(s)
+    assert modes.n_rigid == 1
+    assert modes.omega[1] == pytest.approx(1.911e-3, rel=1e-3)  # Eq. 2.30 with the model's I
