@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from functools import lru_cache
 
+import numpy as np
 import pint
 
 from microg.errors import InputError
@@ -116,6 +117,8 @@ def parse_quantity(
                 fix=f"write it with a unit of {dimension}, e.g. '{q.magnitude} {si}'",
             )
         q = ureg.Quantity(q.magnitude, default_unit)
+    if not np.isfinite(q.magnitude):
+        raise InputError(f"{text!r} is not a finite number", where=where, fix="give a finite value")
     try:
         value = q.to(_unit(si) if si else ureg.dimensionless).magnitude
     except pint.errors.DimensionalityError:
@@ -124,6 +127,18 @@ def parse_quantity(
             where=where,
             fix=f"use a unit of {dimension}, e.g. {si or 'a plain number'}",
         ) from None
+    # pint treats the radian as dimensionless, so Hz and rad/s would convert 1:1; convert
+    # between cycles and radians explicitly (pint's revolution and rpm already carry 2 pi)
+    unit_text = str(q.units)
+    cyclic = "hertz" in unit_text
+    if dimension == "angular_frequency" and cyclic:
+        value *= 2.0 * np.pi
+    elif dimension == "frequency" and any(
+        w in unit_text for w in ("radian", "revolution", "turn", "cycle")
+    ):
+        value /= 2.0 * np.pi
+    if not np.isfinite(value):
+        raise InputError(f"{text!r} is out of range", where=where, fix="give a finite value")
     return float(value)
 
 
