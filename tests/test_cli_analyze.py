@@ -178,3 +178,18 @@ def test_report_in_headless_chromium(default_run: Path) -> None:
     assert int(m.group(1)) == n_png and int(m.group(2)) == n_png
     console = [ln for ln in proc.stderr.splitlines() if "CONSOLE" in ln]
     assert console == []
+
+
+@pytest.mark.parametrize(
+    ("args", "needle"),
+    [
+        (["--duration", "1e9 s"], "--duration"),
+        (["--duration", "inf s"], "--duration"),
+        (["--method", "ritz", "--elements", "40"], "functions"),
+        (["--out", "/proc/microg-no-such-dir/x"], "--out"),
+    ],
+)
+def test_limits(tmp_path: Path, capsys, args, needle) -> None:
+    rc, _, err = _run(capsys, ["analyze", *FAST, "--out", str(tmp_path / "never"), *args])
+    assert rc == 2 and needle in err and err.count("\n") == 1 and "Traceback" not in err
+    assert not (tmp_path / "never").exists()

@@ -130,3 +130,32 @@ def test_case_filter(tmp_path: Path, capsys) -> None:
     )
     assert rc == 0
     assert set(json.loads(stdout)["table4"]) == {"yz_orbiter"}
+
+
+def test_existing_directory_content_is_kept(tmp_path: Path, capsys) -> None:
+    # --out into a directory that holds other files: only microg's files are (re)written
+    out = tmp_path / "mine"
+    out.mkdir()
+    (out / "keep.txt").write_text("precious")
+    (out / "figure3.png").write_bytes(b"old")
+    rc, _, _ = _run(capsys, ["reproduce", "--out", str(out)])
+    assert rc == 0
+    assert (out / "keep.txt").read_text() == "precious"
+    assert (out / "figure3.png").read_bytes()[:4] == b"\x89PNG"
+    assert not [p for p in out.iterdir() if p.name.startswith(".")]  # no temporaries left
+
+
+@pytest.mark.parametrize(
+    ("args", "needle"),
+    [
+        (["--out", "/proc/microg-no-such-dir/x"], "--out"),
+        (["--f0", "-5"], "--f0"),
+        (["--z-e", "nan ft"], "--z-e"),
+        (["--z-e", "1e400 ft"], "--z-e"),
+    ],
+)
+def test_more_bad_input(tmp_path: Path, capsys, args, needle) -> None:
+    out_args = [] if "--out" in args else ["--out", str(tmp_path / "never")]
+    rc, _, err = _run(capsys, ["reproduce", *out_args, *args])
+    assert rc == 2 and needle in err and err.count("\n") == 1 and "Traceback" not in err
+    assert not (tmp_path / "never").exists()

@@ -33,6 +33,9 @@ __all__ = [
     "AXES",
 ]
 
+#: largest number of output samples of one analysis (memory: ~100 bytes per sample and mode)
+MAX_SAMPLES = 2_000_000
+
 AXES: dict[str, np.ndarray] = {
     "x": np.array([1.0, 0, 0]),
     "y": np.array([0, 1.0, 0]),
@@ -185,6 +188,7 @@ class Analysis:
     isolation: dict[str, IsolationAdvice]
     timepts: np.ndarray
     warnings: list[str] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
 
     def to_dict(self) -> dict:
         """The ``microg analyze --json`` contract."""
@@ -217,6 +221,7 @@ class Analysis:
             "observations": obs,
             "complies": all(a.complies for a in self.assessments.values()),
             "warnings": list(self.warnings),
+            "notes": list(self.notes),
         }
 
 
@@ -386,6 +391,12 @@ def run_analysis(
         raise InputError("no disturbance", where="--force", fix="give at least one --force")
     if opts.dt <= 0 or opts.duration <= opts.dt:
         raise InputError("need 0 < dt < duration", where="--dt/--duration")
+    if opts.duration / opts.dt > MAX_SAMPLES:
+        raise InputError(
+            f"{opts.duration / opts.dt:.3g} output samples is more than {MAX_SAMPLES:,}",
+            where="--duration/--dt",
+            fix="shorten --duration or lengthen --dt",
+        )
     step("structure")
     structure = build_structure(station, opts.method, opts.plane, opts.elements_per_beam)
     points = {name: structure.point(name) for name in opts.observe}
@@ -428,6 +439,15 @@ def run_analysis(
     assessments = {n: assess(timepts, r.acceleration, req) for n, r in responses.items()}
     step("isolation")
     advice = {n: _advise(n, a, opts, responses[n], req) for n, a in assessments.items()}
+    fitted = [m.name for m in station.all_masses() if m.fitted]
+    notes = []
+    if fitted:
+        notes.append(
+            f"{len(fitted)} mass items of model {station.name!r} carry fitted values (marked "
+            f"fitted = true in the model file: {', '.join(sorted(set(fitted)))}); for the "
+            "shipped IOC models these were fitted to the seed report's Appendix C because the "
+            "OCR lost them, so local results near them (the keel) inherit that uncertainty"
+        )
     return Analysis(
         model=station.name,
         options=opts,
@@ -439,6 +459,7 @@ def run_analysis(
         isolation=advice,
         timepts=timepts,
         warnings=warnings,
+        notes=notes,
     )
 
 

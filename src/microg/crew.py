@@ -61,8 +61,10 @@ class CrewPushoff:
         for name, v in vals.items():
             if not np.isfinite(v):
                 raise InputError(f"must be finite, got {v}", where=f"--{name}")
-        if f0 == 0:
-            raise InputError("must not be zero", where="--f0")
+        if not f0 > 0:
+            raise InputError(
+                f"must be > 0, got {f0:g} N", where="--f0", fix="the direction carries the sign"
+            )
         if not t1 > 0:
             raise InputError(f"must be > 0 s, got {t1:g}", where="--t1")
         if not t13 >= t1:

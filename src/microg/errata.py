@@ -262,8 +262,8 @@ _TEXT_ERRATA: list[tuple[str, tuple[str, str]]] = [
         "Eq. 2.19d",
         (
             "missing",
-            "derived (microg.crew): A = sin wt - sin w(t-t1) + sin w(t-t13) "
-            "- sin w(t-t14) - w t1 cos w(t-t1) - w (t14-t13) cos w(t-t13)",
+            "derived (microg.crew): A = sin wt - sin w(t-t1) + (t1/d) [sin w(t-t13) "
+            "- sin w(t-t14)] - w t1 [cos w(t-t1) + cos w(t-t13)], d = t14 - t13",
         ),
     ),
     ("Eq. 2.20b", ("f0/(w^3 t1 M_jj)", "the acceleration scale is f0/(w_j t1 M_jj), as Eq. 3.1")),

@@ -24,6 +24,7 @@ import numpy as np
 from numpy.polynomial import Polynomial
 from numpy.polynomial import legendre as npleg
 
+from microg.errors import InputError
 from microg.model import Beam, RigidBody, Station
 from microg.structure import PointMap, Structure
 
@@ -39,6 +40,9 @@ __all__ = [
     "gravity_gradient_stiffness",
     "PLANES",
 ]
+
+#: most admissible functions per beam (polynomials up to degree 17 stay well conditioned)
+MAX_FUNCTIONS = 16
 
 #: planar analyses of the report: lateral direction, rotation axis (so that a rotation
 #: q moves a point at height z by +z q laterally), normal of the plane
@@ -122,6 +126,13 @@ def planar_coordinates(
     rotation_scale : float, optional
         Length scale of the rotation coordinate, m (default ``station.reference_length``).
     """
+    if not (isinstance(n_functions, int | np.integer) and 1 <= n_functions <= MAX_FUNCTIONS):
+        raise InputError(
+            f"assumed functions per beam must be an integer from 1 to {MAX_FUNCTIONS}, "
+            f"got {n_functions!r}",
+            where="--functions/--elements",
+            fix="use the finite-element method for finer models",
+        )
     spec = PLANES[plane]
     scale = station.reference_length if rotation_scale is None else rotation_scale
     coords = [
@@ -247,7 +258,7 @@ def assemble(
     coords: Sequence[Coordinate],
     *,
     gravity_gradient: bool = True,
-    quadrature_points: int = 24,
+    quadrature_points: int | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Generalized mass (Eq. 2.5) and stiffness (Eq. 2.6 + Appendix B-2) matrices, SI.
 
@@ -258,8 +269,9 @@ def assemble(
     gravity_gradient : bool
         Add ``k = 3 w0^2 (I_a - I_b) / scale^2`` on each rotation coordinate (Appendix B-2
         with the 1/l_k^2 factor the coordinate q = theta l_k needs).
-    quadrature_points : int
-        Gauss-Legendre points per beam (exact for polynomial functions of degree < 2 x this).
+    quadrature_points : int, optional
+        Gauss-Legendre points per beam (exact for polynomials of degree < 2 x this); by
+        default enough for the products of the highest-degree functions, exactly.
 
     Returns
     -------
@@ -269,6 +281,9 @@ def assemble(
     motions = [_root_motion(station, c) for c in coords]
     mass = np.zeros((n, n))
     stiff = np.zeros((n, n))
+    if quadrature_points is None:
+        degree = max((c.shape.degree() for c in coords if c.shape is not None), default=3)
+        quadrature_points = max(8, degree + 2)  # 2 x points - 1 >= 2 x degree: exact
     xg, wg = np.polynomial.legendre.leggauss(quadrature_points)
     xg = 0.5 * (xg + 1.0)
     wg = 0.5 * wg

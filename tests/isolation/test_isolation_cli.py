@@ -96,3 +96,31 @@ def test_bad_input_one_line_exit_2(
     assert out == ""
     lines = err.strip().splitlines()
     assert len(lines) == 1 and option in lines[0] and "Traceback" not in err
+
+
+def test_hz_and_rad_per_s_agree(capsys) -> None:
+    # 1 Hz is 2 pi rad/s: the two spellings must give the same design (pint alone would not)
+    import json as _json
+
+    from microg.cli import main as _main
+
+    assert _main(["isolate", "design", "--weight", "1000 lbf", "--omega", "1 Hz", "--json"]) == 0
+    a = _json.loads(capsys.readouterr().out)
+    assert (
+        _main(
+            ["isolate", "design", "--weight", "1000 lbf", "--omega", "6.283185307179586", "--json"]
+        )
+        == 0
+    )
+    b = _json.loads(capsys.readouterr().out)
+    assert a["k1"] == b["k1"]
+
+
+def test_range_too_large(capsys) -> None:
+    from microg.cli import main as _main
+
+    rc = _main(
+        ["isolate", "curve", "--k", "10", "--mu", "0.05", "--zeta", "0.2", "--r2", "0:6:2000000000"]
+    )
+    err = capsys.readouterr().err
+    assert rc == 2 and "--r2" in err and err.count("\n") == 1

@@ -174,9 +174,12 @@ def analyze(
             raise InputError(
                 f"{len(vals)} values for {n} --force", where=opt, fix="give one, or one per --force"
             )
-    for p in (*at_points, *observe):
-        if p not in names:
-            raise InputError(f"unknown point {p!r}", fix=f"known points: {', '.join(names)}")
+    for opt, pts in (("--at", at_points), ("--observe", observe)):
+        for p in pts:
+            if p not in names:
+                raise InputError(
+                    f"unknown point {p!r}", where=opt, fix=f"known points: {', '.join(names)}"
+                )
     dists = []
     for i, spec in enumerate(forces):
         f = parse_force_spec(spec)
@@ -220,19 +223,13 @@ def analyze(
 def write_outputs(result, out_dir: Path) -> Path:  # type: ignore[no-untyped-def]
     """Render figures, HTML and JSON, and write them into ``out_dir`` atomically."""
     from microg.analysis_report import figures, render_analysis
-    from microg.ioutil import atomic_directory, dumps
+    from microg.ioutil import dumps, write_output_files
 
     figs = figures(result)
     html = render_analysis(result, figs)
     text = dumps(result.to_dict())
-
-    def fill(tmp: Path) -> None:
-        for name, png in figs.items():
-            (tmp / name).write_bytes(png)
-        (tmp / "report.html").write_text(html, encoding="utf-8")
-        (tmp / "results.json").write_text(text, encoding="utf-8")
-
-    return atomic_directory(out_dir, fill)
+    files: dict[str, bytes | str] = {**figs, "report.html": html, "results.json": text}
+    return write_output_files(out_dir, files, where="--out")
 
 
 def _summary(result, path: Path) -> None:  # type: ignore[no-untyped-def]

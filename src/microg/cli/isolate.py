@@ -280,7 +280,15 @@ def claims(mu_max: float, as_json: bool) -> None:
 )
 def figure8(out: str, r2_max: float) -> None:
     """Figure 8: M_a against r^2, six panels at zeta = 0.2."""
+    from pathlib import Path
+
+    from microg.errors import InputError
     from microg.isolation.figures import figure8 as make
 
-    make(out, r2_max=r2_max)
+    if Path(out).suffix.lower() != ".png":
+        raise InputError(f"{out!r} is not a .png file", where="--out", fix="name it *.png")
+    try:
+        make(out, r2_max=r2_max)
+    except OSError as exc:
+        raise InputError(f"cannot write {out}: {exc.strerror or exc}", where="--out") from None
     click.echo(f"wrote {out}")

@@ -261,16 +261,11 @@ def locate(
     data = _map_json(amap, loc, label, crew)
     text = dumps(data)
     if out_dir is not None:
-        from microg.ioutil import atomic_directory
+        from microg.ioutil import write_output_files
         from microg.plots import png_bytes
 
         png = png_bytes(map_figure(amap, measure=measure, title=f"{label}: {method}", best=loc))
-
-        def fill(tmp: Path) -> None:
-            (tmp / "map.json").write_text(text, encoding="utf-8")
-            (tmp / "map.png").write_bytes(png)
-
-        path = atomic_directory(out_dir, fill)
+        path = write_output_files(out_dir, {"map.json": text, "map.png": png}, where="--out")
     if as_json:
         click.echo(text)
         return

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import click
 
 from microg.errors import InputError
@@ -79,6 +81,9 @@ class RangeType(click.ParamType):
 
     name = "START:STOP:N"
 
+    def __init__(self, max_points: int = 1_000_000):
+        self.max_points = max_points
+
     def convert(self, value, param, ctx):  # type: ignore[no-untyped-def]
         if isinstance(value, tuple):
             return value
@@ -87,11 +92,18 @@ class RangeType(click.ParamType):
             self.fail(f"expected START:STOP:N, got {value!r}", param, ctx)
         try:
             start, stop = float(parts[0]), float(parts[1])
+        except ValueError:
+            self.fail(f"START and STOP must be numbers, got {value!r}", param, ctx)
+        try:
             n = int(parts[2])
         except ValueError:
-            self.fail(f"expected numbers in START:STOP:N, got {value!r}", param, ctx)
+            self.fail(f"N must be an integer, got {parts[2]!r}", param, ctx)
+        if not (math.isfinite(start) and math.isfinite(stop)):
+            self.fail(f"START and STOP must be finite, got {value!r}", param, ctx)
         if not (start < stop) or n < 2:
             self.fail(f"need START < STOP and N >= 2, got {value!r}", param, ctx)
+        if n > self.max_points:
+            self.fail(f"N must be <= {self.max_points:,}, got {n:,}", param, ctx)
         return (start, stop, n)
 
 
@@ -110,6 +122,6 @@ class BandType(click.ParamType):
             lo, hi = float(parts[0]), float(parts[1])
         except ValueError:
             self.fail(f"expected numbers in LO:HI, got {value!r}", param, ctx)
-        if not (0 <= lo < hi) or hi == float("inf"):
+        if not (0 <= lo < hi) or not math.isfinite(hi):
             self.fail(f"need 0 <= LO < HI < inf, got {value!r}", param, ctx)
         return (lo, hi)

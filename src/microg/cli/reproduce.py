@@ -92,7 +92,7 @@ def reproduce(
     """
     from microg.crew import CrewPushoff
     from microg.ioc import FT
-    from microg.ioutil import atomic_directory, dumps
+    from microg.ioutil import dumps, write_output_files
     from microg.plots import figure3, figure4, png_bytes, png_data_uri, point_response_figure
     from microg.report import render_reproduction
     from microg.reproduce import ReproduceOptions
@@ -116,14 +116,14 @@ def reproduce(
     html = render_reproduction(rep, png_data_uri(fig3), png_data_uri(fig4), png_data_uri(fig_resp))
     text = dumps(rep.contract())
 
-    def fill(tmp: Path) -> None:
-        (tmp / "figure3.png").write_bytes(fig3)
-        (tmp / "figure4.png").write_bytes(fig4)
-        (tmp / "lab-response.png").write_bytes(fig_resp)
-        (tmp / "report.html").write_text(html, encoding="utf-8")
-        (tmp / "results.json").write_text(text, encoding="utf-8")
-
-    path = atomic_directory(out_dir, fill)
+    files = {
+        "figure3.png": fig3,
+        "figure4.png": fig4,
+        "lab-response.png": fig_resp,
+        "report.html": html,
+        "results.json": text,
+    }
+    path = write_output_files(out_dir, files, where="--out")
     if as_json:
         click.echo(text)
     else:
