@@ -92,7 +92,9 @@ def test_model_matrices_within_two_percent_or_explained(rep, case: str) -> None:
             if abs(ac.element_rel_diff[i, j]) > 0.02:
                 assert f"m{i + 1}{j + 1}" in explained
     if case == "xz_orbiter":
-        assert np.max(np.abs(ac.element_rel_diff)) < 0.02  # C-1 matches everywhere
+        # regression of the fit (C-1 is its target, so this is not an independent check):
+        # a change of the model file or the Ritz engine that breaks the match shows here
+        assert np.max(np.abs(ac.element_rel_diff)) < 0.02
     else:
         assert explained == {"m24", "m34"}
 
