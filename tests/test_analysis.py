@@ -30,12 +30,12 @@ def _opts(**kw) -> AnalysisOptions:
 
 def test_ritz_response_equals_direct_integration(station) -> None:
     # reference: solve_ivp (DOP853, rtol 1e-11) of the physical equations M q'' + K q = b f(t)
-    # of the same assumed-modes model, integrated between the force's breakpoints; the modal
+    # of the same (3-D) assumed-modes model, integrated between the force's breakpoints; the modal
     # route keeps every mode (undamped), so both are the same ODE: agreement to 1e-6 of the peak
     res = run_analysis(
         station, _opts(method="ritz", elements_per_beam=2, zeta=0.0, max_freq_hz=1e6)
     )
-    s = build_ritz(station, "xz", 2, gravity_gradient=False)
+    s = build_ritz(station, None, 2, gravity_gradient=False)  # the 3-D assumed-modes model
     f = crew_pushoff()
     b = s.point("crew").translation.T @ AXES["x"]
     minv_k = np.linalg.solve(s.mass, s.stiffness)

@@ -82,7 +82,7 @@ class AnalysisOptions:
     method : str
         ``"fem"`` (3-D frame elements) or ``"ritz"`` (the report's planar assumed modes).
     plane : str
-        ``"xz"`` or ``"yz"`` for ``ritz``.
+        ``"3d"`` (default), ``"xz"`` or ``"yz"`` for ``ritz``.
     elements_per_beam : int
         Finite elements per beam (``fem``); assumed functions per beam (``ritz``).
     zeta : float
@@ -104,7 +104,7 @@ class AnalysisOptions:
     disturbances: Sequence[Disturbance]
     observe: Sequence[str]
     method: str = "fem"
-    plane: str = "xz"
+    plane: str = "3d"
     elements_per_beam: int = 10
     zeta: float = 0.005
     max_freq_hz: float = 10.0
@@ -285,7 +285,7 @@ def build_structure(station: Station, method: str, plane: str, n: int) -> Struct
     if method == "ritz":
         from microg.ritz import build_ritz
 
-        return build_ritz(station, plane, n, gravity_gradient=False)
+        return build_ritz(station, None if plane == "3d" else plane, n, gravity_gradient=False)
     raise InputError(f"unknown method {method!r}", where="--method", fix="use fem or ritz")
 
 

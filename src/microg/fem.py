@@ -52,7 +52,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from microg.errors import InputError
-from microg.model import Beam, RigidBody, Station
+from microg.model import POLAR_GYRATION_FRACTION, Beam, RigidBody, Station
 from microg.structure import PointMap, Structure
 
 __all__ = [
@@ -76,8 +76,6 @@ DOF_NAMES = ("ux", "uy", "uz", "rx", "ry", "rz")
 AXIAL_PENALTY = 1e6
 #: torsionally rigid beams (gj = 0): GJ = TORSION_PENALTY * max(EI_y, EI_z)
 TORSION_PENALTY = 1e4
-#: polar radius of gyration / beam length when ``ea`` is absent
-POLAR_GYRATION_FRACTION = 0.02
 #: default number of elements per beam when neither discretisation option is given
 DEFAULT_ELEMENTS_PER_BEAM = 10
 
@@ -371,11 +369,7 @@ def _effective_properties(beam: Beam) -> tuple[float, float, float]:
     ei_max = max(beam.ei_y, beam.ei_z)
     ea = beam.ea if beam.ea is not None else AXIAL_PENALTY * ei_max / beam.length**2
     gj = beam.gj if beam.gj > 0 else TORSION_PENALTY * ei_max
-    if beam.ea is not None:
-        rho_j = beam.mass_per_length * (beam.ei_y + beam.ei_z) / beam.ea
-    else:
-        rho_j = beam.mass_per_length * (POLAR_GYRATION_FRACTION * beam.length) ** 2
-    return float(ea), float(gj), float(rho_j)
+    return float(ea), float(gj), beam.polar_mass_per_length
 
 
 def build_fem(

@@ -15,7 +15,19 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["PointMass", "RigidBody", "Beam", "NamedPoint", "Orbit", "Station"]
+__all__ = [
+    "PointMass",
+    "RigidBody",
+    "Beam",
+    "NamedPoint",
+    "Orbit",
+    "Station",
+    "POLAR_GYRATION_FRACTION",
+]
+
+#: radius of gyration of a beam's cross-section, as a fraction of its length, when the model
+#: gives no axial stiffness to derive it from (torsional inertia only; see Beam.polar_mass)
+POLAR_GYRATION_FRACTION = 0.02
 
 
 @dataclass(frozen=True)
@@ -109,6 +121,18 @@ class Beam:
     ea: float | None
     mass_per_length: float
     masses: tuple[PointMass, ...] = ()
+
+    @property
+    def polar_mass_per_length(self) -> float:
+        """Polar mass moment per length rho J of the cross-section, kg m (torsional inertia).
+
+        ``m' (EI_y + EI_z) / EA`` (rho J = m'/A (I_y + I_z) for one material) when ``ea`` is
+        given; otherwise a radius of gyration of ``POLAR_GYRATION_FRACTION`` of the length.
+        Only torsional frequencies depend on it.
+        """
+        if self.ea is not None and self.ea > 0:
+            return float(self.mass_per_length * (self.ei_y + self.ei_z) / self.ea)
+        return float(self.mass_per_length * (POLAR_GYRATION_FRACTION * self.length) ** 2)
 
     @property
     def local_z(self) -> np.ndarray:

@@ -35,6 +35,8 @@ __all__ = [
     "planar_coordinates",
     "assemble",
     "build_ritz",
+    "spatial_coordinates",
+    "clamped_linear_functions",
     "point_maps",
     "sample_points",
     "gravity_gradient_stiffness",
@@ -102,6 +104,77 @@ def cantilever_functions(n: int) -> list[Polynomial]:
     return funcs
 
 
+def clamped_linear_functions(n: int) -> list[Polynomial]:
+    """``n`` admissible functions with f(0) = 0 for torsion and axial motion (xi in [0, 1]).
+
+    The first is xi (uniform twist or stretch: exact for a tip torque or tip force on a
+    uniform member); then xi P_k(2 xi - 1), k = 1..n-1, spanning xi..xi^n.
+    """
+    x = Polynomial([-1.0, 2.0])
+    xi = Polynomial([0.0, 1.0])
+    funcs = []
+    for k in range(n):
+        coef = np.zeros(k + 1)
+        coef[k] = 1.0
+        funcs.append(xi * Polynomial(npleg.leg2poly(coef))(x))
+    return funcs
+
+
+def spatial_coordinates(
+    station: Station, n_functions: int = 1, *, rotation_scale: float | None = None
+) -> list[Coordinate]:
+    """Three-dimensional assumed-modes coordinates of ``station``.
+
+    Six rigid-body coordinates (translations along x, y, z; rotations about x, y, z through
+    the origin, scaled by ``rotation_scale``), and for every beam ``n_functions`` bending
+    functions along its local y and z axes, ``n_functions`` torsion functions (unless the
+    beam is torsionally rigid, ``gj = 0``) and ``n_functions`` axial functions (only when it
+    has an axial stiffness ``ea``).
+
+    Parameters
+    ----------
+    station : Station
+    n_functions : int
+        Functions per beam and per deformation kind (1 to ``MAX_FUNCTIONS``).
+    rotation_scale : float, optional
+        Length scale of the rotation coordinates, m (default ``station.reference_length``).
+    """
+    _check_functions(n_functions)
+    scale = station.reference_length if rotation_scale is None else rotation_scale
+    eye = np.eye(3)
+    coords = [Coordinate(f"translation:{a}", "translation", eye[i]) for i, a in enumerate("xyz")]
+    coords += [
+        Coordinate(f"rotation:{a}", "rotation", eye[i], scale=scale) for i, a in enumerate("xyz")
+    ]
+    bend = cantilever_functions(n_functions)
+    lin = clamped_linear_functions(n_functions)
+    for beam in station.beams:
+        for tag, d in (("y", beam.orientation), ("z", beam.local_z)):
+            for k, f in enumerate(bend):
+                coords.append(Coordinate(f"{beam.name}:{tag}{k + 1}", "bending", d, beam.name, f))
+        if beam.gj > 0:
+            for k, f in enumerate(lin):
+                coords.append(
+                    Coordinate(f"{beam.name}:t{k + 1}", "torsion", beam.direction, beam.name, f)
+                )
+        if beam.ea is not None:
+            for k, f in enumerate(lin):
+                coords.append(
+                    Coordinate(f"{beam.name}:a{k + 1}", "axial", beam.direction, beam.name, f)
+                )
+    return coords
+
+
+def _check_functions(n_functions: int) -> None:
+    if not (isinstance(n_functions, int | np.integer) and 1 <= n_functions <= MAX_FUNCTIONS):
+        raise InputError(
+            f"assumed functions per beam must be an integer from 1 to {MAX_FUNCTIONS}, "
+            f"got {n_functions!r}",
+            where="--functions/--elements",
+            fix="use the finite-element method for finer models",
+        )
+
+
 def _bending_direction(beam: Beam, plane: str) -> np.ndarray:
     """The in-plane direction perpendicular to the beam axis (lateral if the axis is normal)."""
     lateral = PLANES[plane]["lateral"]
@@ -126,13 +199,7 @@ def planar_coordinates(
     rotation_scale : float, optional
         Length scale of the rotation coordinate, m (default ``station.reference_length``).
     """
-    if not (isinstance(n_functions, int | np.integer) and 1 <= n_functions <= MAX_FUNCTIONS):
-        raise InputError(
-            f"assumed functions per beam must be an integer from 1 to {MAX_FUNCTIONS}, "
-            f"got {n_functions!r}",
-            where="--functions/--elements",
-            fix="use the finite-element method for finer models",
-        )
+    _check_functions(n_functions)
     spec = PLANES[plane]
     scale = station.reference_length if rotation_scale is None else rotation_scale
     coords = [
@@ -188,25 +255,41 @@ def _root_motion(
             cp = _root_point(child)
             t_c = t_root + np.cross(th, cp - rp)
             th_c = th.copy()
-            if isinstance(comp, Beam) and coord.kind == "bending" and coord.beam == comp.name:
-                s = comp.arc_length(cp)
-                t_c = t_c + _bend_t(comp, coord, s)
-                th_c = th_c + _bend_r(comp, coord, s)
+            if isinstance(comp, Beam) and coord.beam == comp.name:
+                s = np.array([comp.arc_length(cp)])
+                dt, dr = _own_motion(comp, coord, s, (cp - comp.station_position(s))[None, :])
+                t_c = t_c + dt[0]
+                th_c = th_c + dr[0]
             visit(child, cp, t_c, th_c)
 
     visit(root, origin, t0, th0)
     return out
 
 
-def _bend_t(beam: Beam, coord: Coordinate, s: np.ndarray | float) -> np.ndarray:
-    xi = np.asarray(s, float) / beam.length
-    return np.multiply.outer(coord.shape(xi), coord.vector)
+def _own_motion(
+    beam: Beam, coord: Coordinate, s: np.ndarray, offset: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Translation and rotation (p, 3) from the beam's own deformation coordinate.
 
-
-def _bend_r(beam: Beam, coord: Coordinate, s: np.ndarray | float) -> np.ndarray:
+    Bending along ``d``: ``w = d psi(s/L)``, rotation ``(a x d) psi'(s/L)/L``; torsion:
+    rotation ``a phi(s/L)``; axial: ``a chi(s/L)``.  ``offset`` (p, 3) is each point's
+    distance from the axis point at ``s`` (zero for points on the axis): the cross-section
+    moves rigidly.
+    """
     xi = np.asarray(s, float) / beam.length
-    slope = coord.shape.deriv()(xi) / beam.length
-    return np.multiply.outer(slope, np.cross(beam.direction, coord.vector))
+    a = beam.direction
+    p = xi.size
+    t = np.zeros((p, 3))
+    r = np.zeros((p, 3))
+    if coord.kind == "bending":
+        t = np.multiply.outer(coord.shape(xi), coord.vector)
+        slope = coord.shape.deriv()(xi) / beam.length
+        r = np.multiply.outer(slope, np.cross(a, coord.vector))
+    elif coord.kind == "torsion":
+        r = np.multiply.outer(coord.shape(xi), a)
+    elif coord.kind == "axial":
+        t = np.multiply.outer(coord.shape(xi), a)
+    return t + np.cross(r, offset), r
 
 
 def _field(
@@ -226,10 +309,11 @@ def _field(
         rp, t, th = motions[i][comp_name]
         tr[:, :, i] = t + np.cross(th, positions - rp)
         rot[:, :, i] = th
-        if c.kind == "bending" and c.beam == comp_name and isinstance(comp, Beam):
+        if c.beam == comp_name and isinstance(comp, Beam):
             s = (positions - comp.root) @ comp.direction
-            tr[:, :, i] += _bend_t(comp, c, s)
-            rot[:, :, i] += _bend_r(comp, c, s)
+            dt, dr = _own_motion(comp, c, s, positions - comp.station_position(s))
+            tr[:, :, i] += dt
+            rot[:, :, i] += dr
     return tr, rot
 
 
@@ -302,9 +386,13 @@ def assemble(
         s = xg * beam.length
         pos = beam.station_position(s)
         if beam.mass_per_length > 0:
-            tr, _ = _field(station, coords, beam.name, pos, motions)
+            tr, rot = _field(station, coords, beam.name, pos, motions)
             w = wg * beam.length * beam.mass_per_length
             mass += np.einsum("p,pai,paj->ij", w, tr, tr)
+            # torsional inertia of the cross-sections (rho J about the beam axis)
+            twist = np.einsum("pai,a->pi", rot, beam.direction)
+            wj = wg * beam.length * beam.polar_mass_per_length
+            mass += np.einsum("p,pi,pj->ij", wj, twist, twist)
         # bending strain energy: curvature of each coordinate on this beam
         idx = [i for i, c in enumerate(coords) if c.kind == "bending" and c.beam == beam.name]
         if idx:
@@ -317,6 +405,13 @@ def assemble(
             ] * (dirs @ ez)[None, :] * beam.ei_y
             kk = eimat * np.einsum("p,ip,jp->ij", wg * beam.length, curv, curv)
             stiff[np.ix_(idx, idx)] += kk
+        for kind, rigidity in (("torsion", beam.gj), ("axial", beam.ea or 0.0)):
+            idx = [i for i, c in enumerate(coords) if c.kind == kind and c.beam == beam.name]
+            if idx:
+                grad = np.array([coords[i].shape.deriv()(xg) / beam.length for i in idx])
+                stiff[np.ix_(idx, idx)] += rigidity * np.einsum(
+                    "p,ip,jp->ij", wg * beam.length, grad, grad
+                )
     if gravity_gradient:
         _, _, inertia_cm = station.mass_properties()
         for i, c in enumerate(coords):
@@ -393,7 +488,7 @@ def sample_points(
 
 def build_ritz(
     station: Station,
-    plane: str = "xz",
+    plane: str | None = "xz",
     n_functions: int = 1,
     *,
     gravity_gradient: bool = True,
@@ -404,15 +499,22 @@ def build_ritz(
     Parameters
     ----------
     station : Station
-    plane : {"xz", "yz"}
+    plane : {"xz", "yz"} or None
+        The report's planar analysis, or None for the three-dimensional model
+        (:func:`spatial_coordinates`: bending both ways, torsion, axial where elastic).
     n_functions : int
-        Admissible functions per beam.
+        Admissible functions per beam (and per deformation kind in 3-D).
     gravity_gradient : bool
-        Include the gravity-gradient stiffness on the rotation coordinate.
+        Include the gravity-gradient stiffness on the rotation coordinates.
     coords : sequence of Coordinate, optional
         Custom coordinates (overrides ``plane``/``n_functions``).
     """
-    coords = list(coords) if coords is not None else planar_coordinates(station, plane, n_functions)
+    if coords is not None:
+        coords = list(coords)
+    elif plane is None:
+        coords = spatial_coordinates(station, n_functions)
+    else:
+        coords = planar_coordinates(station, plane, n_functions)
     mass, stiff = assemble(station, coords, gravity_gradient=gravity_gradient)
     total, cm, inertia = station.mass_properties()
     rigid = {}

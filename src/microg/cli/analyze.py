@@ -56,10 +56,11 @@ __all__ = ["analyze"]
 )
 @click.option(
     "--plane",
-    type=click.Choice(["xz", "yz"]),
-    default="xz",
+    type=click.Choice(["3d", "xz", "yz"]),
+    default="3d",
     show_default=True,
-    help="Plane of the assumed-modes analysis (--method ritz).",
+    help="--method ritz: the three-dimensional assumed-modes model, or the report's planar "
+    "model in the X-Z or Y-Z plane.",
 )
 @click.option(
     "--elements",

@@ -37,7 +37,8 @@ def build_structure(
     if method == "ritz":
         from microg.ritz import build_ritz
 
-        return station, build_ritz(station, plane or "xz", functions or 1)
+        ritz_plane = None if plane == "3d" else (plane or "xz")
+        return station, build_ritz(station, ritz_plane, functions or 1)
     from microg.fem import build_fem
 
     return station, build_fem(station, elements_per_beam=elements)
@@ -85,14 +86,15 @@ def _effective_percent(structure, m) -> dict[str, np.ndarray]:  # type: ignore[n
 )
 @click.option(
     "--plane",
-    type=click.Choice(["xz", "yz"]),
+    type=click.Choice(["xz", "yz", "3d"]),
     default=None,
-    help="Ritz: the plane of the planar model (default xz).  FE: report only the modes "
-    "with more than half of their kinetic energy in this plane.",
+    help="Ritz: the report's planar model in this plane (default xz), or 3d for the "
+    "three-dimensional assumed-modes model.  FE: report only the modes with more than half "
+    "of their kinetic energy in this plane.",
 )
 @click.option(
     "--functions",
-    type=click.IntRange(1, 40),
+    type=click.IntRange(1, 16),
     default=None,
     help="Ritz: admissible functions per beam (default 1, the report's model).",
 )
@@ -127,6 +129,8 @@ def modes(
     M-orthogonal to the rigid motions; non-zero where gravity gradient restrains a rotation).
     """
     _, structure = build_structure(model, method, plane, functions, elements)
+    if plane == "3d":
+        plane = None
     m = solve_for_cli(structure, method, plane, n_modes)
     plane_out = structure.plane if method == "ritz" else plane
     if as_json:
