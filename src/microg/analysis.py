@@ -11,10 +11,11 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from microg.assess import Assessment, assess, iss_requirement, report_flat_requirement
+from microg.assess import Assessment, Requirement, assess, iss_requirement, report_flat_requirement
 from microg.errors import InputError
 from microg.forces import ForceHistory
 from microg.model import Station
@@ -22,6 +23,10 @@ from microg.modes import Modes, solve_modes
 from microg.response import PointResponse, generalized_force_vector, response_at_points
 from microg.structure import Structure
 from microg.units import G0
+
+if TYPE_CHECKING:
+    from microg.isolation.design import MountDesign
+    from microg.isolation.mount import MountChoice
 
 __all__ = [
     "Disturbance",
@@ -128,7 +133,7 @@ class IsolationAdvice:
         Lowest and highest band edges where the requirement is exceeded, Hz.
     target_ma : float
         Largest acceleration magnification that brings every exceeding band to its limit.
-    design : object or None
+    design : MountDesign or None
         :class:`microg.isolation.design.MountDesign`: the report's rule (M_a over the
         exceeding band), with stiffness, natural frequency and sag.
     note : str
@@ -139,7 +144,7 @@ class IsolationAdvice:
         The package's acceleration assessed against the same requirement.
     peak_stroke : float or None
         Largest package motion relative to the mount over the axes (rattle space), m.
-    mount : object or None
+    mount : MountChoice or None
         :class:`microg.isolation.mount.MountChoice`: the recommended spring-damper mount
         from the whole-spectrum screen (``found`` False when none complies).
     """
@@ -148,12 +153,12 @@ class IsolationAdvice:
     needed: bool
     band_hz: tuple[float, float] | None
     target_ma: float | None
-    design: object | None
+    design: MountDesign | None
     note: str
     package_accel: np.ndarray | None = None
     isolated: Assessment | None = None
     peak_stroke: float | None = None
-    mount: object | None = None
+    mount: MountChoice | None = None
 
 
 @dataclass(frozen=True)
@@ -225,8 +230,8 @@ class Analysis:
         }
 
 
-def _advice_dict(adv: IsolationAdvice) -> dict:
-    out = {
+def _advice_dict(adv: IsolationAdvice) -> dict[str, Any]:
+    out: dict[str, Any] = {
         "needed": adv.needed,
         "band_hz": adv.band_hz,
         "target_Ma": adv.target_ma,
@@ -294,7 +299,7 @@ def _advise(
     a: Assessment,
     opts: AnalysisOptions,
     response: PointResponse,
-    requirement: object,
+    requirement: Requirement,
 ) -> IsolationAdvice:
     from microg.isolation.design import design_mount
     from microg.isolation.mount import search_mount
@@ -347,7 +352,7 @@ def _advise(
         )
     runs = [package_response(mount, response.timepts, row) for row in response.acceleration]
     pkg = np.array([r.package_accel for r in runs])
-    isolated = assess(response.timepts, pkg, requirement)  # type: ignore[arg-type]
+    isolated = assess(response.timepts, pkg, requirement)
     stroke = max(r.peak_stroke for r in runs)
     if choice.found:
         note += (

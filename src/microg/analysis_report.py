@@ -46,12 +46,14 @@ def _modes_figure(result: Analysis) -> Figure:
 
 def _isolation_figure(result: Analysis, name: str) -> Figure:
     adv = result.isolation[name]
+    package_accel = adv.package_accel
+    assert package_accel is not None  # the caller draws this figure only for isolated points
     r = result.responses[name]
     axis = int(np.argmax(np.max(np.abs(r.acceleration), axis=1)))
     fig = Figure(figsize=(7.5, 4.0), layout="constrained")
     ax = fig.add_subplot()
     ax.plot(r.timepts, r.acceleration[axis] / 9.80665 * 1e6, lw=0.8, label="mount (station)")
-    ax.plot(r.timepts, adv.package_accel[axis] / 9.80665 * 1e6, lw=0.9, label="isolated package")
+    ax.plot(r.timepts, package_accel[axis] / 9.80665 * 1e6, lw=0.9, label="isolated package")
     ax.set_xlabel("time [s]")
     ax.set_ylabel(f"acceleration, {'xyz'[axis]} [micro-g]")
     ax.set_title(f"What the package feels at {name} on the advised mount")

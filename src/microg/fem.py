@@ -52,7 +52,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from microg.errors import InputError
-from microg.model import POLAR_GYRATION_FRACTION, Beam, RigidBody, Station
+from microg.model import POLAR_GYRATION_FRACTION, Beam, PointMass, RigidBody, Station
 from microg.structure import PointMap, Structure
 
 __all__ = [
@@ -320,6 +320,7 @@ class _Mesh:
             node = self.body_node[component]
         elif component in self.beam_s:
             beam = station.component(component)
+            assert isinstance(beam, Beam)  # beam_s holds only beams
             k = int(np.argmin(np.abs(self.beam_s[component] - beam.arc_length(position))))
             node = int(self.beam_ref[component][k])
         else:
@@ -506,7 +507,7 @@ def build_fem(
         mval.append(me.ravel())
 
     # point masses: on bodies (offset from the master), on beams (at their node)
-    carriers: list[tuple[str, object]] = [
+    carriers: list[tuple[str, PointMass]] = [
         (bd.name, pm) for bd in station.bodies for pm in bd.masses
     ]
     carriers += [(bm.name, pm) for bm in station.beams for pm in bm.masses]

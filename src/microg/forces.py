@@ -441,7 +441,7 @@ def parse_force_spec(spec: str, *, where: str = "--force") -> ForceHistory:
         params = _parse_params(tail, f"{where} {spec}") if sep else {}
         if key == "crew-pushoff":
             return lib["report-pushoff"].history(name="crew-pushoff", **params)
-        return lib[key].history(**params)
+        return lib[key].history(name=None, **params)
     path = Path(spec)
     if path.is_file() or path.suffix.lower() == ".csv":
         if not path.is_file():

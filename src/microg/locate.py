@@ -1320,7 +1320,8 @@ def map_figure(
         xy = amap.positions[line.index][:, ax_idx]
         segs = np.stack([xy[:-1], xy[1:]], axis=1)
         seg_val = 0.5 * (logv[line.index][:-1] + logv[line.index][1:])
-        lc = LineCollection(segs, cmap="viridis", norm=norm, linewidths=5)
+        # matplotlib's stub wants a Sequence; an (nseg, 2, 2) ndarray is accepted at run time
+        lc = LineCollection(segs, cmap="viridis", norm=norm, linewidths=5)  # type: ignore[arg-type]
         lc.set_array(seg_val)
         ax.add_collection(lc)
     sc = ax.scatter(

@@ -233,7 +233,8 @@ class Station:
 
     def component(self, name: str) -> RigidBody | Beam:
         """The body or beam called ``name`` (KeyError if none)."""
-        for c in (*self.bodies, *self.beams):
+        components: tuple[RigidBody | Beam, ...] = (*self.bodies, *self.beams)
+        for c in components:
             if c.name == name:
                 return c
         raise KeyError(name)

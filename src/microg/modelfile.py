@@ -478,8 +478,8 @@ class _Builder:
         self.kind: dict[str, tuple[str, int]] = {}
         for i, b in enumerate(doc.body):
             self.kind[b.name] = ("body", i)
-        for i, b in enumerate(doc.beam):
-            self.kind[b.name] = ("beam", i)
+        for i, bm in enumerate(doc.beam):
+            self.kind[bm.name] = ("beam", i)
 
         # beam scalars and raw geometry, in file order
         geo = [self.beam_geometry(i, b) for i, b in enumerate(doc.beam)]
@@ -599,7 +599,11 @@ class _Builder:
                     "give every point its own name",
                 )
             seen[p.name] = f"point[{i}].name"
-        for kind, comps_ in (("body", doc.body), ("beam", doc.beam)):
+        groups: tuple[tuple[str, Sequence[_BodyIn | _BeamIn]], ...] = (
+            ("body", doc.body),
+            ("beam", doc.beam),
+        )
+        for kind, comps_ in groups:
             for i, c in enumerate(comps_):
                 seen = {}
                 for j, m in enumerate(c.mass):
@@ -732,11 +736,11 @@ class _Builder:
                     "required key is missing",
                     f"add the point where it joins beam {b.parent!r}, e.g. {_EXAMPLES['at']}",
                 )
-        for i, b in enumerate(doc.beam):
-            if b.parent not in self.kind:
+        for i, bm in enumerate(doc.beam):
+            if bm.parent not in self.kind:
                 raise self.error(
                     f"beam[{i}].parent",
-                    f"no body or beam named {b.parent!r}",
+                    f"no body or beam named {bm.parent!r}",
                     f"name one of: {known}",
                 )
 

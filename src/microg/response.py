@@ -39,11 +39,15 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from microg.errors import InputError
 from microg.units import G0
+
+if TYPE_CHECKING:
+    from microg.forces import ForceHistory
 
 __all__ = [
     "ModalResponse",
@@ -554,7 +558,7 @@ def response_at_points(
     zeta: np.ndarray | float,
     phi: np.ndarray,
     point_maps: Mapping[str, np.ndarray],
-    force_history: object,
+    force_history: ForceHistory,
     force_dof_vector: np.ndarray,
     timepts_out: np.ndarray,
 ) -> dict[str, PointResponse]:
@@ -588,8 +592,8 @@ def response_at_points(
         raise InputError(
             f"force_dof_vector must have shape ({phi.shape[0]},)", where="response_at_points"
         )
-    timepts_force = np.asarray(force_history.timepts, dtype=float)  # type: ignore[attr-defined]
-    force = np.asarray(force_history.force, dtype=float)  # type: ignore[attr-defined]
+    timepts_force = np.asarray(force_history.timepts, dtype=float)
+    force = np.asarray(force_history.force, dtype=float)
     gamma = phi.T @ b  # (m,) modal participation per newton
     modal = modal_pwl_response(omega, zeta, timepts_force, np.outer(gamma, force), timepts_out)
     out: dict[str, PointResponse] = {}

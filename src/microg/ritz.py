@@ -82,6 +82,12 @@ class Coordinate:
     scale: float = 1.0
 
 
+def _shape(coord: Coordinate) -> Polynomial:
+    """The shape function of a beam-deformation coordinate (bending, torsion, axial)."""
+    assert coord.shape is not None, f"coordinate {coord.label!r} has no shape function"
+    return coord.shape
+
+
 def report_cantilever_function() -> Polynomial:
     """The report's cantilever function psi = xi^2 - xi^3/3 (Eq. 2.21c-d)."""
     return Polynomial([0.0, 0.0, 1.0, -1.0 / 3.0])
@@ -215,9 +221,8 @@ def planar_coordinates(
 
 
 def _children(station: Station) -> dict[str, list[Beam | RigidBody]]:
-    kids: dict[str, list[Beam | RigidBody]] = {
-        c.name: [] for c in (*station.bodies, *station.beams)
-    }
+    components: tuple[Beam | RigidBody, ...] = (*station.bodies, *station.beams)
+    kids: dict[str, list[Beam | RigidBody]] = {c.name: [] for c in components}
     for beam in station.beams:
         kids[beam.parent].append(beam)
     for body in station.bodies[1:]:
@@ -282,13 +287,14 @@ def _own_motion(
     t = np.zeros((p, 3))
     r = np.zeros((p, 3))
     if coord.kind == "bending":
-        t = np.multiply.outer(coord.shape(xi), coord.vector)
-        slope = coord.shape.deriv()(xi) / beam.length
+        shape = _shape(coord)
+        t = np.multiply.outer(shape(xi), coord.vector)
+        slope = shape.deriv()(xi) / beam.length
         r = np.multiply.outer(slope, np.cross(a, coord.vector))
     elif coord.kind == "torsion":
-        r = np.multiply.outer(coord.shape(xi), a)
+        r = np.multiply.outer(_shape(coord)(xi), a)
     elif coord.kind == "axial":
-        t = np.multiply.outer(coord.shape(xi), a)
+        t = np.multiply.outer(_shape(coord)(xi), a)
     return t + np.cross(r, offset), r
 
 
@@ -397,7 +403,7 @@ def assemble(
         idx = [i for i, c in enumerate(coords) if c.kind == "bending" and c.beam == beam.name]
         if idx:
             ey, ez = beam.orientation, beam.local_z
-            curv = np.array([coords[i].shape.deriv(2)(xg) / beam.length**2 for i in idx])
+            curv = np.array([_shape(coords[i]).deriv(2)(xg) / beam.length**2 for i in idx])
             dirs = np.array([coords[i].vector for i in idx])
             # bending along local y is resisted by EI_z, along local z by EI_y
             eimat = (dirs @ ey)[:, None] * (dirs @ ey)[None, :] * beam.ei_z + (dirs @ ez)[
@@ -408,7 +414,7 @@ def assemble(
         for kind, rigidity in (("torsion", beam.gj), ("axial", beam.ea or 0.0)):
             idx = [i for i, c in enumerate(coords) if c.kind == kind and c.beam == beam.name]
             if idx:
-                grad = np.array([coords[i].shape.deriv()(xg) / beam.length for i in idx])
+                grad = np.array([_shape(coords[i]).deriv()(xg) / beam.length for i in idx])
                 stiff[np.ix_(idx, idx)] += rigidity * np.einsum(
                     "p,ip,jp->ij", wg * beam.length, grad, grad
                 )

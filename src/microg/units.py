@@ -28,7 +28,7 @@ G0 = 9.80665
 #: the report's weight-to-mass conversion, ft/s^2 (608,600 lb / 32.2 = 18,900 slug, Appendix C-1)
 G0_US = 32.2
 
-ureg = pint.UnitRegistry()
+ureg: pint.UnitRegistry = pint.UnitRegistry()
 ureg.define("micro_g = 1e-6 * standard_gravity = ug")
 ureg.define("milli_g = 1e-3 * standard_gravity = mg_accel")
 
@@ -100,7 +100,7 @@ def parse_quantity(
             )
         text = f"{text} {default_unit}"
     try:
-        q = ureg.Quantity(str(text).strip())
+        q: pint.Quantity = ureg.Quantity(str(text).strip())
     except (pint.errors.PintError, ValueError, TypeError, AttributeError, SyntaxError) as exc:
         raise InputError(
             f"cannot read {text!r} as a {dimension}: {exc}".replace("\n", " "),

@@ -221,7 +221,7 @@ def analyze(
         _summary(result, path)
 
 
-def write_outputs(result, out_dir: Path) -> Path:  # type: ignore[no-untyped-def]
+def write_outputs(result, out_dir: Path) -> Path:
     """Render figures, HTML and JSON, and write them into ``out_dir`` atomically."""
     from microg.analysis_report import figures, render_analysis
     from microg.ioutil import dumps, write_output_files
@@ -233,7 +233,7 @@ def write_outputs(result, out_dir: Path) -> Path:  # type: ignore[no-untyped-def
     return write_output_files(out_dir, files, where="--out")
 
 
-def _summary(result, path: Path) -> None:  # type: ignore[no-untyped-def]
+def _summary(result, path: Path) -> None:
     m = result.modes
     el = ~m.rigid & result.used
     click.echo(

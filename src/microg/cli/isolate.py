@@ -19,7 +19,7 @@ __all__ = ["isolate"]
 _LBF_PER_N = 1.0 / 4.4482216152605
 
 
-def _nonneg_range(ctx: click.Context, param: click.Parameter, value):  # type: ignore[no-untyped-def]
+def _nonneg_range(ctx: click.Context, param: click.Parameter, value):
     if value is not None and value[0] < 0:
         raise click.BadParameter(
             f"need START >= 0 (r^2 is a square), got {value[0]:g}:{value[1]:g}:{value[2]}"

@@ -27,7 +27,7 @@ class MovableType(click.ParamType):
 
     name = "NAME=LO:HI"
 
-    def convert(self, value, param, ctx):  # type: ignore[no-untyped-def]
+    def convert(self, value, param, ctx):
         if isinstance(value, tuple):
             return value
         text = str(value)
@@ -52,7 +52,7 @@ class CarryType(click.ParamType):
 
     name = "POINT=MASS"
 
-    def convert(self, value, param, ctx):  # type: ignore[no-untyped-def]
+    def convert(self, value, param, ctx):
         if isinstance(value, tuple):
             return value
         text = str(value)
@@ -62,7 +62,7 @@ class CarryType(click.ParamType):
         return (point.strip(), mass.strip())
 
 
-def _force_options(f):  # type: ignore[no-untyped-def]
+def _force_options(f):
     opts = [
         click.option(
             "--f0",
@@ -98,13 +98,13 @@ def _force_options(f):  # type: ignore[no-untyped-def]
     return f
 
 
-def _crew(f0: float, t1: float, t13: float, t14: float):  # type: ignore[no-untyped-def]
+def _crew(f0: float, t1: float, t13: float, t14: float):
     from microg.crew import CrewPushoff
 
     return CrewPushoff.checked(f0, t1, t13, t14)
 
 
-def _map_json(amap, loc, model: str, crew) -> dict:  # type: ignore[no-untyped-def]
+def _map_json(amap, loc, model: str, crew) -> dict:
     g = 1.0 / G0
     lt = amap.long_time_peak
     return {
@@ -274,7 +274,7 @@ def locate(
         click.echo(f"map written to {path / 'map.json'} and {path / 'map.png'}")
 
 
-def _summary(amap, loc, label: str) -> None:  # type: ignore[no-untyped-def]
+def _summary(amap, loc, label: str) -> None:
     g = 1.0 / G0
     where = f", plane {amap.plane}" if amap.plane else ""
     click.echo(

@@ -25,7 +25,7 @@ def build_structure(
     plane: str | None,
     functions: int | None,
     elements: int | None,
-):  # type: ignore[no-untyped-def]
+):
     """Load ``model`` and discretise it; option conflicts are InputErrors (exit 2)."""
     from microg.modelfile import load_station
 
@@ -44,7 +44,7 @@ def build_structure(
     return station, build_fem(station, elements_per_beam=elements)
 
 
-def solve_for_cli(structure, method: str, plane: str | None, n_modes: int | None):  # type: ignore[no-untyped-def]
+def solve_for_cli(structure, method: str, plane: str | None, n_modes: int | None):
     """Modes of ``structure``; for frame models with ``plane``, only the in-plane modes.
 
     A frame mode is in ``plane`` when more than half of its kinetic energy is in-plane
@@ -64,7 +64,7 @@ def solve_for_cli(structure, method: str, plane: str | None, n_modes: int | None
     return m.subset(keep)
 
 
-def _effective_percent(structure, m) -> dict[str, np.ndarray]:  # type: ignore[no-untyped-def]
+def _effective_percent(structure, m) -> dict[str, np.ndarray]:
     """Effective mass per direction as a percentage of the station's r^T M r."""
     out = {}
     for d, r in structure.rigid_body.items():

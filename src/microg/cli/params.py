@@ -36,7 +36,7 @@ class QuantityType(click.ParamType):
     def get_metavar(self, param: click.Parameter, ctx: click.Context | None = None) -> str:
         return "Q" if self.default_unit is None else f"Q[{self.default_unit}]"
 
-    def convert(self, value, param, ctx):  # type: ignore[no-untyped-def]
+    def convert(self, value, param, ctx):
         if isinstance(value, float):
             return value
         try:
@@ -62,7 +62,7 @@ class PositiveFloat(click.ParamType):
         self.minimum = minimum
         self.strict = strict
 
-    def convert(self, value, param, ctx):  # type: ignore[no-untyped-def]
+    def convert(self, value, param, ctx):
         try:
             x = float(value)
         except (TypeError, ValueError):
@@ -84,7 +84,7 @@ class RangeType(click.ParamType):
     def __init__(self, max_points: int = 1_000_000):
         self.max_points = max_points
 
-    def convert(self, value, param, ctx):  # type: ignore[no-untyped-def]
+    def convert(self, value, param, ctx):
         if isinstance(value, tuple):
             return value
         parts = str(value).split(":")
@@ -112,7 +112,7 @@ class BandType(click.ParamType):
 
     name = "LO:HI"
 
-    def convert(self, value, param, ctx):  # type: ignore[no-untyped-def]
+    def convert(self, value, param, ctx):
         if isinstance(value, tuple):
             return value
         parts = str(value).split(":")

@@ -116,7 +116,7 @@ def reproduce(
     html = render_reproduction(rep, png_data_uri(fig3), png_data_uri(fig4), png_data_uri(fig_resp))
     text = dumps(rep.contract())
 
-    files = {
+    files: dict[str, bytes | str] = {
         "figure3.png": fig3,
         "figure4.png": fig4,
         "lab-response.png": fig_resp,
@@ -130,7 +130,7 @@ def reproduce(
         _summary(rep, path)
 
 
-def _summary(rep, path: Path) -> None:  # type: ignore[no-untyped-def]
+def _summary(rep, path: Path) -> None:
     click.echo("Table 4 (printed -> recomputed)")
     for case, t4 in rep.table4.items():
         for j, b in enumerate(t4.bending, 1):

@@ -313,7 +313,7 @@ def h2_closed_form(mu: float) -> AbsorberTuning:
 
 def _objective(
     mu: float, band: tuple[float, float] | None, criterion: str, zeta_fixed: float | None
-):  # type: ignore[no-untyped-def]
+):
     def fun(x: NDArray[np.float64]) -> float:
         f = math.exp(x[0])
         zeta = zeta_fixed if zeta_fixed is not None else math.exp(x[1])

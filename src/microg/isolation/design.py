@@ -161,7 +161,7 @@ def design_mount(
         )
     ratio = hi / lo
 
-    def tuned(r_lo: float):  # type: ignore[no-untyped-def]
+    def tuned(r_lo: float):
         return tune_absorber(mu, (r_lo, r_lo * ratio), "peak", zeta=zeta, xtol=1e-6)
 
     # coarse scan of r_lo from the no-absorber value downwards; keep the last feasible point
