@@ -21,10 +21,8 @@ from scipy.optimize import nnls
 
 from microg.ioc import PRINTED, report_matrices
 from microg.model import Beam, Orbit, PointMass, RigidBody, Station
+from microg.units import FT, LBF, SLUG
 
-FT = 0.3048
-SLUG = 14.59390294
-LBF = 4.4482216152605
 G_US = 32.2
 DATA = Path(__file__).resolve().parents[1] / "src" / "microg" / "data"
 
@@ -75,14 +73,26 @@ def build(keel, tip_w, tip_iyy, orb_iyy, arr_ixx, arr_iyy, orbiter=True, tip_ixx
     """Station from fitted unknowns (US units in, SI out)."""
     ms = [_pm(n, w, (0, 0, z), source="Table 3") for n, z, w in MAIN]
     if orbiter:
-        ms.append(_pm(ORBITER[0], ORBITER[2], (0, 0, ORBITER[1]), (ORBITER_IXX, orb_iyy, ORBITER_IXX)))
+        ms.append(
+            _pm(ORBITER[0], ORBITER[2], (0, 0, ORBITER[1]), (ORBITER_IXX, orb_iyy, ORBITER_IXX))
+        )
     body = RigidBody("main", tuple(ms))
     ei = EI * LBF * FT**2
     kms = [_pm(f"keel mass {i + 1}", w, (0, 0, z), fitted=True) for i, (z, w) in enumerate(keel)]
     kms.append(_pm("Upper boom with antenna", tip_w, (0, 0, LK), (tip_ixx, tip_iyy, 0.0)))
     keel_beam = Beam(
-        "keel", "main", np.zeros(3), np.array([0, 0, 1.0]), LK * FT, np.array([1.0, 0, 0]),
-        ei, ei, GJ * LBF * FT**2, None, KEEL_MPL * SLUG / FT, tuple(kms),
+        "keel",
+        "main",
+        np.zeros(3),
+        np.array([0, 0, 1.0]),
+        LK * FT,
+        np.array([1.0, 0, 0]),
+        ei,
+        ei,
+        GJ * LBF * FT**2,
+        None,
+        KEEL_MPL * SLUG / FT,
+        tuple(kms),
     )
     beams = [keel_beam]
     for sgn, nm in ((1, "boom+y"), (-1, "boom-y")):
@@ -92,9 +102,18 @@ def build(keel, tip_w, tip_iyy, orb_iyy, arr_ixx, arr_iyy, orbiter=True, tip_ixx
             bm.append(_pm(n, w, (0, sgn * y, ZS), inert))
         beams.append(
             Beam(
-                nm, "keel", np.array([0, 0, ZS * FT]), np.array([0, sgn, 0.0]), LS * FT,
-                np.array([1.0, 0, 0]), ei, ei, GJ * LBF * FT**2, None,
-                BOOM_STRUCTURE / 2 / G_US / LS * SLUG / FT, tuple(bm),
+                nm,
+                "keel",
+                np.array([0, 0, ZS * FT]),
+                np.array([0, sgn, 0.0]),
+                LS * FT,
+                np.array([1.0, 0, 0]),
+                ei,
+                ei,
+                GJ * LBF * FT**2,
+                None,
+                BOOM_STRUCTURE / 2 / G_US / LS * SLUG / FT,
+                tuple(bm),
             )
         )
     return Station("ioc", (body,), tuple(beams), (), Orbit(6870e3), reference_length=LK * FT)
@@ -132,7 +151,7 @@ def fit():
         weight[labels.index(lab)] = 0.0
     x, _ = nnls(a * weight[:, None], (target - base) * weight, maxiter=20000)
     keel = [(float(z), float(x[k] * G_US)) for k, z in enumerate(grid) if x[k] > 1e-9]
-    xe = x[len(grid):]
+    xe = x[len(grid) :]
     result = dict(
         keel=keel,
         tip_w=float(xe[0] * G_US),
@@ -165,7 +184,8 @@ def write_toml(result, orbiter: bool) -> str:
         ' solar boom (Tables 1-3, Appendix C)"',
         'units = "US"',
         'weight_gravity = "32.2 ft/s^2"  # the report converts weights with g = 32.2 ft/s^2',
-        'reference_length = "296 ft"     # l_k: the rotation coordinate is q2 = theta * l_k (Eq. 2.21b)',
+        'reference_length = "296 ft"     # l_k: the rotation coordinate is q2 = theta * l_k '
+        "(Eq. 2.21b)",
         "",
         "[orbit]",
         'radius = "6870 km"  # implied by the report\'s 1.89e-3 rad/s libration (domain.md)',
@@ -244,11 +264,18 @@ def write_toml(result, orbiter: bool) -> str:
             "  # Table 3: boom structure 2,345 lb over both sides, g = 32.2 ft/s^2",
         ]
         for n, y, w in BOOM:
-            lines += ["", "  [[beam.mass]]", f'  name = "{n}"', f'  s = "{y} ft"', f'  weight = "{w} lbf"']
+            lines += [
+                "",
+                "  [[beam.mass]]",
+                f'  name = "{n}"',
+                f'  s = "{y} ft"',
+                f'  weight = "{w} lbf"',
+            ]
             if "solar" in n:
                 lines += [
                     f'  inertia = {{ xx = "{result["arr_ixx"]:.6g} slug*ft^2", yy = '
-                    f'"{result["arr_iyy"]:.6g} slug*ft^2", zz = "{result["arr_ixx"]:.6g} slug*ft^2" }}',
+                    f'"{result["arr_iyy"]:.6g} slug*ft^2", '
+                    f'zz = "{result["arr_ixx"]:.6g} slug*ft^2" }}',
                     '  source = "Table 3 weight (half, per side); inertia fitted to C-1/C-3'
                     ' (Table 3 reads ~1.07e5 slug ft^2 per wing, two wings per item)"',
                     "  fitted = true",

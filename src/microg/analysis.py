@@ -22,7 +22,7 @@ from microg.model import Station
 from microg.modes import Modes, solve_modes
 from microg.response import PointResponse, generalized_force_vector, response_at_points
 from microg.structure import Structure
-from microg.units import G0
+from microg.units import G0, IN, LB, LBF
 
 if TYPE_CHECKING:
     from microg.isolation.design import MountDesign
@@ -116,7 +116,7 @@ class AnalysisOptions:
     duration: float = 200.0
     dt: float = 0.01
     requirement: str = "iss"
-    package_mass: float = 1000.0 * 0.45359237
+    package_mass: float = 1000.0 * LB
     absorber_mu: float | None = None
 
 
@@ -254,7 +254,7 @@ def _advice_dict(adv: IsolationAdvice) -> dict[str, Any]:
         out["recommended_mount"] = {
             "found": bool(mc.found),
             "k1_N_per_m": mc.k1,
-            "k1_lbf_per_in": mc.k1 / 175.126835,
+            "k1_lbf_per_in": mc.k1 * IN / LBF,
             "zeta1": mc.zeta1,
             "c1_N_s_per_m": mc.c1,
             "freq_hz_n": mc.freq_hz_n,
@@ -358,7 +358,7 @@ def _advise(
         note += (
             f"; the report's rule gives k1 = {design.k1:.4g} N/m, but its undamped resonance "
             f"at {design.freq_hz_n:.3g} Hz is excited by the transient. Recommended: k1 = "
-            f"{choice.k1:.4g} N/m ({choice.k1 / 175.126835:.4g} lbf/in) with damping ratio "
+            f"{choice.k1:.4g} N/m ({choice.k1 * IN / LBF:.4g} lbf/in) with damping ratio "
             f"{choice.zeta1:g} (c1 = {choice.c1:.4g} N s/m, f_n = {choice.freq_hz_n:.3g} Hz)"
         )
     else:

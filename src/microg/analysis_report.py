@@ -20,6 +20,7 @@ from microg.assess import (  # noqa: E402
 from microg.ioutil import to_jsonable  # noqa: E402
 from microg.plots import png_bytes, png_data_uri  # noqa: E402
 from microg.report import environment  # noqa: E402
+from microg.units import G0  # noqa: E402
 
 __all__ = ["figures", "render_analysis"]
 
@@ -52,8 +53,8 @@ def _isolation_figure(result: Analysis, name: str) -> Figure:
     axis = int(np.argmax(np.max(np.abs(r.acceleration), axis=1)))
     fig = Figure(figsize=(7.5, 4.0), layout="constrained")
     ax = fig.add_subplot()
-    ax.plot(r.timepts, r.acceleration[axis] / 9.80665 * 1e6, lw=0.8, label="mount (station)")
-    ax.plot(r.timepts, package_accel[axis] / 9.80665 * 1e6, lw=0.9, label="isolated package")
+    ax.plot(r.timepts, r.acceleration[axis] / G0 * 1e6, lw=0.8, label="mount (station)")
+    ax.plot(r.timepts, package_accel[axis] / G0 * 1e6, lw=0.9, label="isolated package")
     ax.set_xlabel("time [s]")
     ax.set_ylabel(f"acceleration, {'xyz'[axis]} [micro-g]")
     ax.set_title(f"What the package feels at {name} on the advised mount")

@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from microg.errors import InputError
-from microg.units import parse_quantity
+from microg.units import LBF, parse_quantity
 
 __all__ = [
     "ForceHistory",
@@ -41,7 +41,7 @@ __all__ = [
 ]
 
 #: the report's push-off magnitude, 25 lbf in newtons (1 lbf = 4.4482216152605 N exactly)
-REPORT_F0_N = 25.0 * 4.4482216152605
+REPORT_F0_N = 25.0 * LBF
 
 
 def _readonly(a: np.ndarray) -> np.ndarray:

@@ -22,6 +22,7 @@ from microg.errors import InputError
 from microg.model import Station
 from microg.ritz import build_ritz
 from microg.structure import Structure
+from microg.units import FT, LBF, SLUG
 
 __all__ = [
     "PRINTED",
@@ -36,9 +37,6 @@ __all__ = [
     "report_stiffness_us",
 ]
 
-FT = 0.3048  # m
-SLUG = 14.593902937206364  # kg
-LBF = 4.4482216152605  # N
 #: the four cases of Appendix C / Table 4: (plane, orbiter attached)
 CASES: dict[str, tuple[str, bool]] = {
     "xz_orbiter": ("xz", True),

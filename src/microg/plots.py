@@ -12,6 +12,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 
 from microg.reproduce import CurveSet  # noqa: E402
+from microg.units import G0  # noqa: E402
 
 __all__ = ["figure3", "figure4", "point_response_figure", "png_bytes", "png_data_uri"]
 
@@ -45,8 +46,8 @@ def point_response_figure(responses: dict, z_e_ft: float, z_a_ft: float) -> Figu
     fig, axes = plt.subplots(2, 2, figsize=(9.5, 6.0), layout="constrained", sharex=True)
     for ax, (case, r) in zip(axes.ravel(), responses.items(), strict=False):
         for j, a in enumerate(r.accel_modes, 1):
-            ax.plot(r.timepts, a / 9.80665 * 1e6, lw=0.9, label=f"mode {j}")
-        ax.plot(r.timepts, r.accel / 9.80665 * 1e6, "k", lw=1.1, label="sum")
+            ax.plot(r.timepts, a / G0 * 1e6, lw=0.9, label=f"mode {j}")
+        ax.plot(r.timepts, r.accel / G0 * 1e6, "k", lw=1.1, label="sum")
         ax.set_title(case, fontsize=10)
         ax.grid(alpha=0.3)
         ax.set_ylabel("micro-g")

@@ -16,6 +16,11 @@ from microg.errors import InputError
 __all__ = [
     "G0",
     "G0_US",
+    "FT",
+    "IN",
+    "LB",
+    "LBF",
+    "SLUG",
     "ureg",
     "parse_quantity",
     "to_si",
@@ -27,6 +32,12 @@ __all__ = [
 G0 = 9.80665
 #: the report's weight-to-mass conversion, ft/s^2 (608,600 lb / 32.2 = 18,900 slug, Appendix C-1)
 G0_US = 32.2
+#: US customary units in SI (exact definitions): foot, inch, pound mass, pound force, slug
+FT = 0.3048
+IN = 0.0254
+LB = 0.45359237
+LBF = LB * G0
+SLUG = LBF / FT
 
 ureg: pint.UnitRegistry = pint.UnitRegistry()
 ureg.define("micro_g = 1e-6 * standard_gravity = ug")

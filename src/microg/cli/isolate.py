@@ -13,10 +13,11 @@ import numpy as np
 
 from microg.cli.params import BandType, PositiveFloat, QuantityType, RangeType
 from microg.ioutil import dumps
+from microg.units import LBF
 
 __all__ = ["isolate"]
 
-_LBF_PER_N = 1.0 / 4.4482216152605
+_LBF_PER_N = 1.0 / LBF
 
 
 def _nonneg_range(ctx: click.Context, param: click.Parameter, value):

@@ -14,11 +14,11 @@ import numpy as np
 from microg.cli.params import PositiveFloat, QuantityType
 from microg.errors import InputError
 from microg.ioutil import dumps
-from microg.units import G0, parse_quantity
+from microg.units import FT, G0, parse_quantity
 
 __all__ = ["locate", "optimize", "MovableType", "CarryType"]
 
-_FT = 0.3048
+_FT = FT
 _LATERAL = {"xz": "x", "yz": "y"}
 
 

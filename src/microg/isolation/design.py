@@ -19,7 +19,7 @@ from microg.isolation.transmissibility import (
     accel_magnification,
     accel_magnification_no_absorber,
 )
-from microg.units import G0, G0_US
+from microg.units import G0, G0_US, IN, LBF
 
 __all__ = [
     "MountDesign",
@@ -32,7 +32,7 @@ __all__ = [
 ]
 
 #: lbf/in per N/m
-_N_PER_M_TO_LBF_PER_IN = 0.0254 / 4.4482216152605
+_N_PER_M_TO_LBF_PER_IN = IN / LBF
 
 #: Figure 8 of the report (zeta = 0.2): the k values drawn for fixed mu, the mu values for fixed k
 #: (the figure itself is lost from the scan; these are the report's panel parameters with a
