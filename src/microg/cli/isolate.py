@@ -62,7 +62,11 @@ def isolate() -> None:
 @click.option("--json", "as_json", is_flag=True, help="print {'r2': [...], 'Ma': [...]}")
 def curve(k: float, mu: float, zeta: float, r2: tuple[float, float, int], as_json: bool) -> None:
     """M_a = |U1/U0| against r^2 (Eq. 4.3 solved; printed Eq. 4.7 is garbled)."""
-    from microg.isolation import accel_magnification, accel_magnification_no_absorber
+    from microg.isolation import (
+        absorber_tuning_ratio,
+        accel_magnification,
+        accel_magnification_no_absorber,
+    )
 
     r2v = np.linspace(r2[0], r2[1], r2[2])
     ma = accel_magnification(k, mu, zeta, np.sqrt(r2v))
@@ -72,7 +76,7 @@ def curve(k: float, mu: float, zeta: float, r2: tuple[float, float, int], as_jso
     base = accel_magnification_no_absorber(np.sqrt(r2v))
     click.echo(
         f"k = {k:g}, mu = {mu:g}, zeta = {zeta:g}, f = omega_a/omega_n = "
-        f"{1 / math.sqrt(k * mu):.4g}"
+        f"{float(absorber_tuning_ratio(k, mu)):.4g}"
     )
     click.echo(f"{'r^2':>10} {'M_a':>12} {'no absorber':>12}")
     for x, m, b in zip(r2v, ma, base, strict=True):
