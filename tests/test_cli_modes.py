@@ -103,3 +103,21 @@ def test_bad_model_file_is_one_line(capsys, tmp_path):
     bad.write_text("[station]\nname = 3\n", encoding="utf-8")
     rc, out, err = _run(capsys, str(bad))
     assert rc == 2 and out == "" and len(err.strip().splitlines()) == 1 and "bad.toml" in err
+
+
+def test_massless_beam_named(tmp_path, capsys) -> None:
+    # a beam with no mass makes M singular: the error names the coordinates that carry none
+    model = tmp_path / "massless.toml"
+    model.write_text(
+        '[station]\nname = "m"\n[orbit]\naltitude = "400 km"\n[[body]]\nname = "core"\n'
+        '  [[body.mass]]\n  name = "m"\n  at = ["0 m", "0 m", "0 m"]\n  mass = "1000 kg"\n'
+        '[[beam]]\nname = "arm"\nparent = "core"\nroot = ["0 m", "0 m", "0 m"]\n'
+        'direction = [0, 0, 1]\nlength = "10 m"\nei = "1e6 N*m^2"\ngj = "1e6 N*m^2"\n'
+        'mass_per_length = "0 kg/m"\n'
+    )
+    from microg.cli import main as _main
+
+    for method in ("ritz", "fem"):
+        rc = _main(["modes", str(model), "--method", method])
+        err = capsys.readouterr().err
+        assert rc == 2 and "arm" in err and "no mass" in err and err.count("\n") == 1

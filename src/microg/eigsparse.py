@@ -122,6 +122,7 @@ def solve_sparse(
     *,
     sigma: float | None = None,
     dense_max: int = DENSE_MAX,
+    labels: tuple[str, ...] | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Lowest ``n_modes`` modes (rigid ones included) of ``K phi = omega^2 M phi`` (Eq. 2.10).
 
@@ -140,6 +141,9 @@ def solve_sparse(
         Shift (rad^2/s^2), negative; default ``-1e-12 max_i(K_ii/M_ii)``.
     dense_max : int
         Largest size solved densely.
+
+    labels : tuple of str, optional
+        Coordinate names, to say which coordinates carry no mass.
 
     Returns
     -------
@@ -160,9 +164,18 @@ def solve_sparse(
         raise InputError(f"n_modes must be at least 1, got {n_modes}", where="n_modes")
     diag_m = M.diagonal()
     if np.any(diag_m <= 0):
+        bad = np.flatnonzero(diag_m <= 0)
+        what = (
+            f"coordinates {', '.join(labels[i] for i in bad[:6])}"
+            + (f" and {bad.size - 6} more" if bad.size > 6 else "")
+            + " carry no mass"
+            if labels is not None
+            else "a coordinate carries no mass"
+        )
         raise InputError(
-            "the mass matrix is not positive definite (a coordinate carries no mass)",
-            fix="give every part of the model mass or remove the massless coordinate",
+            f"the mass matrix is not positive definite: {what}",
+            fix="give every part of the model mass (mass_per_length or point masses) "
+            "or remove the massless part",
         )
     B = rigid_basis(M, K, rigid_candidates, tol)
     r = B.shape[1]
@@ -170,7 +183,7 @@ def solve_sparse(
     if n <= dense_max or 2 * n_modes >= n:
         from microg.modes import solve_dense
 
-        omega_d, phi_d, rigid_d = solve_dense(M.toarray(), K.toarray(), B, tol=tol)
+        omega_d, phi_d, rigid_d = solve_dense(M.toarray(), K.toarray(), B, tol=tol, labels=labels)
         if int(np.count_nonzero(rigid_d)) != r:
             raise SolverError(
                 f"dense solver found {np.count_nonzero(rigid_d)} rigid modes, expected {r}"

@@ -111,12 +111,26 @@ def _check_symmetric(a: np.ndarray, name: str) -> np.ndarray:
     return 0.5 * (a + a.T)
 
 
+def _massless(mass: np.ndarray, labels: tuple[str, ...] | None) -> str:
+    """Name the coordinates that dominate the (near-)null space of the mass matrix."""
+    w, v = np.linalg.eigh(mass)
+    null = v[:, w <= 1e-12 * max(w.max(), 1e-300)]
+    if null.size == 0 or labels is None:
+        return "a coordinate carries no mass"
+    weight = np.max(np.abs(null), axis=1)
+    idx = np.flatnonzero(weight > 0.1 * weight.max())
+    names = [labels[i] for i in idx[:6]]
+    more = f" and {idx.size - 6} more" if idx.size > 6 else ""
+    return f"coordinates {', '.join(names)}{more} carry no mass"
+
+
 def solve_dense(
     mass: np.ndarray,
     stiffness: np.ndarray,
     rigid_candidates: np.ndarray | None = None,
     *,
     tol: float = RIGID_TOL,
+    labels: tuple[str, ...] | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Solve ``K phi = omega^2 M phi`` (Eq. 2.10) for a free-free structure, densely.
 
@@ -130,6 +144,8 @@ def solve_dense(
         the candidates, and the same row-wise test decides.
     tol : float
         Row-wise relative tolerance on ``K r`` for rigidity.
+    labels : tuple of str, optional
+        Coordinate names, to say which coordinates carry no mass when M is singular.
 
     Returns
     -------
@@ -146,8 +162,9 @@ def solve_dense(
         sla.cholesky(mass, lower=True)
     except sla.LinAlgError:
         raise InputError(
-            "the mass matrix is not positive definite (a coordinate carries no mass)",
-            fix="give every part of the model mass or remove the massless coordinate",
+            "the mass matrix is not positive definite: " + _massless(mass, labels),
+            fix="give every part of the model mass (mass_per_length or point masses) "
+            "or remove the massless part",
         ) from None
     from microg.eigsparse import rigid_basis
 
@@ -248,11 +265,16 @@ def solve_modes(
         from microg.eigsparse import solve_sparse  # large frame models
 
         omega, phi, rigid = solve_sparse(
-            structure.mass, structure.stiffness, cand, n_modes=n_modes or 30, tol=tol
+            structure.mass,
+            structure.stiffness,
+            cand,
+            n_modes=n_modes or 30,
+            tol=tol,
+            labels=structure.dof_labels,
         )
     else:
         m, k = structure.dense()
-        omega, phi, rigid = solve_dense(m, k, cand, tol=tol)
+        omega, phi, rigid = solve_dense(m, k, cand, tol=tol, labels=structure.dof_labels)
         if n_modes is not None:
             omega, phi, rigid = omega[:n_modes], phi[:, :n_modes], rigid[:n_modes]
     eff, part = effective_mass(structure.mass, phi, rb)
