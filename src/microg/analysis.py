@@ -38,6 +38,9 @@ __all__ = [
     "AXES",
 ]
 
+#: the seed report's criterion: peak acceleration below 1e-5 g (Introduction)
+REPORT_LIMIT_G = 1e-5
+
 #: largest number of output samples of one analysis (memory: ~100 bytes per sample and mode)
 MAX_SAMPLES = 2_000_000
 
@@ -204,6 +207,11 @@ class Analysis:
         for name, a in self.assessments.items():
             d = a.to_dict()
             d["isolation"] = _advice_dict(self.isolation[name])
+            # the seed report's single-number criterion, beside the band-by-band one
+            d["report_criterion"] = {
+                "limit_g": REPORT_LIMIT_G,
+                "peak_within": bool(a.peak_accel_g <= REPORT_LIMIT_G),
+            }
             obs[name] = d
         return {
             "model": self.model,
