@@ -25,6 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
+from microg.crew import CrewPushoff
 from microg.errors import InputError
 from microg.units import LBF, parse_quantity
 
@@ -177,9 +178,8 @@ def crew_pushoff(
             f"times must satisfy 0 < t1 <= t13 < t14, got t1={t1}, t13={t13}, t14={t14} s",
             where=name,
         )
-    t = [0.0, t1, t1, t13, t13, t14]
-    f = [0.0, f0, 0.0, 0.0, -f0, 0.0]
-    return ForceHistory(np.array(t), np.array(f), name)
+    t, f = CrewPushoff(f0, t1, t13, t14).breakpoints()  # Eq. 2.16, one implementation
+    return ForceHistory(t, f, name)
 
 
 def piecewise_linear(

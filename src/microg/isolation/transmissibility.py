@@ -146,9 +146,7 @@ def accel_magnification_no_absorber(r: ArrayLike) -> NDArray[np.float64]:
     r : array_like
         Frequency ratio ``omega/omega_n``, >= 0.
     """
-    r = np.asarray(r, dtype=float)
-    with np.errstate(divide="ignore"):
-        return 1.0 / np.abs(1.0 - r * r)
+    return np.abs(transmissibility_no_absorber(r))
 
 
 def transmissibility_no_absorber(r: ArrayLike) -> NDArray[np.float64]:
