@@ -6,7 +6,7 @@ it in four directions, each carrying two 30 m masts and a tip panel; elements of
 
 Timed in one process, on the same matrices:
 
-* ``microg.modes.solve_modes`` (exact rigid modes + deflated shift-invert, checks);
+* ``microg.dynamics.modes.solve_modes`` (exact rigid modes + deflated shift-invert, checks);
 * baseline: ``scipy.sparse.linalg.eigsh(K, k=36, M=M, sigma=<same shift>, which="LM")``,
   the plain shift-invert call with nothing deflated or checked.
 
@@ -23,10 +23,10 @@ import tracemalloc
 import numpy as np
 import scipy.sparse.linalg as spla
 
-from microg.eigsparse import SHIFT_FRACTION
-from microg.fem import build_fem
-from microg.model import Beam, NamedPoint, Orbit, PointMass, RigidBody, Station
-from microg.modes import solve_modes
+from microg.dynamics.eigsparse import SHIFT_FRACTION
+from microg.dynamics.modes import solve_modes
+from microg.models.station import Beam, NamedPoint, Orbit, PointMass, RigidBody, Station
+from microg.structure.fem import build_fem
 
 
 def comb_station(n_booms: int = 140) -> Station:

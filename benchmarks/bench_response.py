@@ -1,4 +1,4 @@
-"""Benchmark: exact modal response (microg.response) against scipy.signal.lsim, same run.
+"""Benchmark: exact modal response (microg.dynamics.response) against scipy.signal.lsim, same run.
 
 Problem (the issue's "Speed" item): 100 modes (6 rigid, omega = 0; 94 elastic, 0.1-40 Hz, zeta 0
 to 0.02), 20,001 uniform output times over 0-200 s, the report's crew push-off (Eq. 2.16: f0 = 25
@@ -25,8 +25,8 @@ import numpy as np
 from scipy import signal
 from scipy.linalg import block_diag
 
-from microg.forces import crew_pushoff, piecewise_linear
-from microg.response import modal_pwl_response, response_at_points
+from microg.dynamics.forces import crew_pushoff, piecewise_linear
+from microg.dynamics.response import modal_pwl_response, response_at_points
 
 N_MODES, N_RIGID, N_DOF = 100, 6, 300
 T_END, N_T = 200.0, 20_001

@@ -19,8 +19,8 @@ from pathlib import Path
 import numpy as np
 from scipy.optimize import nnls
 
-from microg.ioc import PRINTED, report_matrices
-from microg.model import Beam, Orbit, PointMass, RigidBody, Station
+from microg.models.station import Beam, Orbit, PointMass, RigidBody, Station
+from microg.seed.ioc import PRINTED, report_matrices
 from microg.units import FT, LBF, SLUG
 
 G_US = 32.2

@@ -7,9 +7,9 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from microg.analysis import AXES, AnalysisOptions, Disturbance, run_analysis
-from microg.forces import crew_pushoff
-from microg.modelfile import load_station
-from microg.ritz import build_ritz
+from microg.dynamics.forces import crew_pushoff
+from microg.models.toml import load_station
+from microg.structure.ritz import build_ritz
 
 
 @pytest.fixture(scope="module")

@@ -15,13 +15,19 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from microg.assess import Assessment, Requirement, assess, iss_requirement, report_flat_requirement
+from microg.dynamics.forces import ForceHistory
+from microg.dynamics.modes import Modes, solve_modes
+from microg.dynamics.response import PointResponse, generalized_force_vector, response_at_points
+from microg.environment.metrics import (
+    Assessment,
+    Requirement,
+    assess,
+    iss_requirement,
+    report_flat_requirement,
+)
 from microg.errors import InputError
-from microg.forces import ForceHistory
-from microg.model import Station
-from microg.modes import Modes, solve_modes
-from microg.response import PointResponse, generalized_force_vector, response_at_points
-from microg.structure import Structure
+from microg.models.station import Station
+from microg.structure.structure import Structure
 from microg.units import G0, IN, LB, LBF
 
 if TYPE_CHECKING:
@@ -292,11 +298,11 @@ def _advice_dict(adv: IsolationAdvice) -> dict[str, Any]:
 def build_structure(station: Station, method: str, plane: str, n: int) -> Structure:
     """Discretise ``station`` by ``method`` ("fem": n elements per beam; "ritz": n functions)."""
     if method == "fem":
-        from microg.fem import build_fem
+        from microg.structure.fem import build_fem
 
         return build_fem(station, elements_per_beam=n)
     if method == "ritz":
-        from microg.ritz import build_ritz
+        from microg.structure.ritz import build_ritz
 
         return build_ritz(station, None if plane == "3d" else plane, n, gravity_gradient=False)
     raise InputError(f"unknown method {method!r}", where="--method", fix="use fem or ritz")

@@ -9,9 +9,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from microg.condense import condensed_modes
-from microg.ioc import PRINTED, report_stiffness_us
-from microg.reproduce import reproduce
+from microg.seed.condense import condensed_modes
+from microg.seed.ioc import PRINTED, report_stiffness_us
+from microg.seed.reproduce import reproduce
 
 
 @pytest.fixture(scope="module")

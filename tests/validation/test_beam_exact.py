@@ -34,10 +34,10 @@ import pytest
 import scipy.linalg as sla
 from scipy.optimize import brentq
 
-from microg.eigsparse import solve_sparse
-from microg.fem import build_fem, constrain
-from microg.model import Beam, Orbit, PointMass, RigidBody, Station
-from microg.modes import solve_modes
+from microg.dynamics.eigsparse import solve_sparse
+from microg.dynamics.modes import solve_modes
+from microg.models.station import Beam, Orbit, PointMass, RigidBody, Station
+from microg.structure.fem import build_fem, constrain
 
 L = 10.0  # m
 EI_Y = 2.0e6  # N m^2: bending about local y -> deflection along local z (station y here)

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from microg.isolation import accel_magnification, check_section42_claims
-from microg.isolation.figures import figure8
+from microg.plotting.isolation import figure8
 
 G_REPORT = 32.2  # ft/s^2, the report's weight-to-mass conversion
 

@@ -12,10 +12,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from microg.fem import build_fem
-from microg.modelfile import load_station
-from microg.modes import solve_modes
-from microg.ritz import build_ritz
+from microg.dynamics.modes import solve_modes
+from microg.models.toml import load_station
+from microg.structure.fem import build_fem
+from microg.structure.ritz import build_ritz
 
 N_CHECK = 10  # elastic modes compared
 

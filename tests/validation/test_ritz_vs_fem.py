@@ -26,13 +26,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from microg.crew import CrewPushoff
-from microg.fem import build_fem
-from microg.forces import REPORT_F0_N
-from microg.locate import acceleration_map, elastic_mask, in_plane_fraction, sample_shapes
-from microg.modelfile import load_station
-from microg.modes import solve_modes
-from microg.ritz import build_ritz
+from microg.dynamics.crew import CrewPushoff
+from microg.dynamics.forces import REPORT_F0_N
+from microg.dynamics.modes import solve_modes
+from microg.location.amap import acceleration_map, elastic_mask, in_plane_fraction, sample_shapes
+from microg.models.toml import load_station
+from microg.structure.fem import build_fem
+from microg.structure.ritz import build_ritz
 
 FT = 0.3048
 CREW = CrewPushoff(REPORT_F0_N)

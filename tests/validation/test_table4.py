@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from microg.crew import CrewPushoff
-from microg.ioc import FT, LBF
-from microg.reproduce import ReproduceOptions, reproduce
+from microg.dynamics.crew import CrewPushoff
+from microg.seed.ioc import FT, LBF
+from microg.seed.reproduce import ReproduceOptions, reproduce
 from microg.units import G0
 
 

@@ -150,9 +150,9 @@ def analyze(
     from tqdm import tqdm
 
     from microg.analysis import AnalysisOptions, Disturbance, run_analysis
+    from microg.dynamics.forces import _parse_direction, parse_force_spec
     from microg.errors import InputError
-    from microg.forces import _parse_direction, parse_force_spec
-    from microg.modelfile import load_station
+    from microg.models.toml import load_station
     from microg.units import G0
 
     if zeta >= 1.0:
@@ -215,7 +215,7 @@ def analyze(
     bar.update(1)
     bar.close()
     if as_json:
-        from microg.ioutil import dumps
+        from microg._io import dumps
 
         click.echo(dumps(result.to_dict()))
     else:
@@ -224,8 +224,8 @@ def analyze(
 
 def write_outputs(result, out_dir: Path) -> Path:
     """Render figures, HTML and JSON, and write them into ``out_dir`` atomically."""
-    from microg.analysis_report import figures, render_analysis
-    from microg.ioutil import dumps, write_output_files
+    from microg._io import dumps, write_output_files
+    from microg.report.analysis import figures, render_analysis
 
     figs = figures(result)
     html = render_analysis(result, figs)

@@ -11,8 +11,8 @@ import math
 import click
 import numpy as np
 
+from microg._io import dumps
 from microg.cli.params import BandType, PositiveFloat, QuantityType, RangeType
-from microg.ioutil import dumps
 from microg.units import LBF
 
 __all__ = ["isolate"]
@@ -288,7 +288,7 @@ def figure8(out: str, r2_max: float) -> None:
     from pathlib import Path
 
     from microg.errors import InputError
-    from microg.isolation.figures import figure8 as make
+    from microg.plotting.isolation import figure8 as make
 
     if Path(out).suffix.lower() != ".png":
         raise InputError(f"{out!r} is not a .png file", where="--out", fix="name it *.png")

@@ -1,6 +1,6 @@
 """``microg locate`` and ``microg optimize``: where to put the laboratory (conclusions 6, 7, 9).
 
-Both commands only parse options (units at the boundary), call :mod:`microg.locate` and
+Both commands only parse options (units at the boundary), call :mod:`microg.location.amap` and
 print or write its result objects.
 """
 
@@ -11,9 +11,9 @@ from pathlib import Path
 import click
 import numpy as np
 
+from microg._io import dumps
 from microg.cli.params import PositiveFloat, QuantityType
 from microg.errors import InputError
-from microg.ioutil import dumps
 from microg.units import FT, G0, parse_quantity
 
 __all__ = ["locate", "optimize", "MovableType", "CarryType"]
@@ -99,7 +99,7 @@ def _force_options(f):
 
 
 def _crew(f0: float, t1: float, t13: float, t14: float):
-    from microg.crew import CrewPushoff
+    from microg.dynamics.crew import CrewPushoff
 
     return CrewPushoff.checked(f0, t1, t13, t14)
 
@@ -238,7 +238,7 @@ def locate(
     mode (report conclusion 7, Figure 9) and the quietest sample.
     """
     from microg.cli.modes import build_structure, solve_for_cli
-    from microg.locate import acceleration_map, best_location, map_figure
+    from microg.location.amap import acceleration_map, best_location, map_figure
 
     if not damping < 1:
         raise InputError(f"must be < 1, got {damping:g}", where="--damping")
@@ -261,8 +261,8 @@ def locate(
     data = _map_json(amap, loc, label, crew)
     text = dumps(data)
     if out_dir is not None:
-        from microg.ioutil import write_output_files
-        from microg.plots import png_bytes
+        from microg._io import write_output_files
+        from microg.plotting.seed import png_bytes
 
         png = png_bytes(map_figure(amap, measure=measure, title=f"{label}: {method}", best=loc))
         path = write_output_files(out_dir, {"map.json": text, "map.png": png}, where="--out")
@@ -363,8 +363,8 @@ def optimize(
     Objective (report conclusion 9): Eq. 3.1 summed over the elastic modes at the experiment
     site, exact [A]max, assumed-modes model rebuilt for every trial layout.
     """
-    from microg.locate import optimize_layout
-    from microg.modelfile import load_station
+    from microg.location.amap import optimize_layout
+    from microg.models.toml import load_station
 
     crew = _crew(f0, t1, t13, t14)
     station = load_station(model)

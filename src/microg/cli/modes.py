@@ -1,8 +1,9 @@
 """``microg modes``: natural frequencies, rigid-body modes, modal and effective masses.
 
 The command computes nothing itself: it loads the model, builds the assumed-modes
-(:func:`microg.ritz.build_ritz`) or frame finite-element (:func:`microg.fem.build_fem`)
-structure, solves it with :func:`microg.modes.solve_modes` and prints the result.
+(:func:`~microg.structure.ritz.build_ritz`) or frame finite-element
+(:func:`~microg.structure.fem.build_fem`)
+structure, solves it with :func:`microg.dynamics.modes.solve_modes` and prints the result.
 """
 
 from __future__ import annotations
@@ -10,8 +11,8 @@ from __future__ import annotations
 import click
 import numpy as np
 
+from microg._io import dumps
 from microg.errors import InputError
-from microg.ioutil import dumps
 
 __all__ = ["modes", "build_structure", "DEFAULT_FEM_MODES"]
 
@@ -27,7 +28,7 @@ def build_structure(
     elements: int | None,
 ):
     """Load ``model`` and discretise it; option conflicts are InputErrors (exit 2)."""
-    from microg.modelfile import load_station
+    from microg.models.toml import load_station
 
     if method == "ritz" and elements is not None:
         raise InputError("applies to --method fem only", where="--elements")
@@ -35,11 +36,11 @@ def build_structure(
         raise InputError("applies to --method ritz only", where="--functions")
     station = load_station(model)
     if method == "ritz":
-        from microg.ritz import build_ritz
+        from microg.structure.ritz import build_ritz
 
         ritz_plane = None if plane == "3d" else (plane or "xz")
         return station, build_ritz(station, ritz_plane, functions or 1)
-    from microg.fem import build_fem
+    from microg.structure.fem import build_fem
 
     return station, build_fem(station, elements_per_beam=elements)
 
@@ -48,10 +49,10 @@ def solve_for_cli(structure, method: str, plane: str | None, n_modes: int | None
     """Modes of ``structure``; for frame models with ``plane``, only the in-plane modes.
 
     A frame mode is in ``plane`` when more than half of its kinetic energy is in-plane
-    motion (:func:`microg.locate.in_plane_fraction`).  ``n_modes`` counts reported modes.
+    motion (:func:`microg.location.amap.in_plane_fraction`).  ``n_modes`` counts reported modes.
     """
-    from microg.locate import in_plane_fraction
-    from microg.modes import solve_modes
+    from microg.dynamics.modes import solve_modes
+    from microg.location.amap import in_plane_fraction
 
     if method == "ritz":
         return solve_modes(structure, n_modes)

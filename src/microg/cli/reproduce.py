@@ -7,7 +7,7 @@ from pathlib import Path
 import click
 
 from microg.cli.params import QuantityType
-from microg.ioc import CASES
+from microg.seed.ioc import CASES
 
 __all__ = ["reproduce"]
 
@@ -90,13 +90,19 @@ def reproduce(
     OUT/lab-response.png (Eq. 2.20b at z_e) and OUT/results.json; every computed value
     follows the crew-force and point options.
     """
-    from microg.crew import CrewPushoff
-    from microg.ioc import FT
-    from microg.ioutil import dumps, write_output_files
-    from microg.plots import figure3, figure4, png_bytes, png_data_uri, point_response_figure
-    from microg.report import render_reproduction
-    from microg.reproduce import ReproduceOptions
-    from microg.reproduce import reproduce as run
+    from microg._io import dumps, write_output_files
+    from microg.dynamics.crew import CrewPushoff
+    from microg.plotting.seed import (
+        figure3,
+        figure4,
+        png_bytes,
+        png_data_uri,
+        point_response_figure,
+    )
+    from microg.report.html import render_reproduction
+    from microg.seed.ioc import FT
+    from microg.seed.reproduce import ReproduceOptions
+    from microg.seed.reproduce import reproduce as run
 
     crew = CrewPushoff.checked(f0, t1, t13, t14)
     rep = run(ReproduceOptions(crew, z_e, z_a))

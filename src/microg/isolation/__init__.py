@@ -4,7 +4,7 @@ Modules: :mod:`~microg.isolation.transmissibility` (kernels of Eqs. 4.3-4.7),
 :mod:`~microg.isolation.absorber` (Den Hartog / H2 / numerical tuning),
 :mod:`~microg.isolation.design` (physical-unit mount design, Section 4.2 claims),
 :mod:`~microg.isolation.timedomain` (exact response to a sampled mount acceleration),
-:mod:`~microg.isolation.figures` (Figure 8).
+:mod:`~microg.plotting.isolation` (Figure 8).
 """
 
 from microg.isolation.absorber import (

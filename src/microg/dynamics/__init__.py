@@ -1,0 +1,1 @@
+"""dynamics stage of microg (see docs/architecture.md)."""

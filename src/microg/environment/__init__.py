@@ -1,0 +1,1 @@
+"""environment stage of microg (see docs/architecture.md)."""

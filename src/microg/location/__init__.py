@@ -1,0 +1,1 @@
+"""location stage of microg (see docs/architecture.md)."""

@@ -1,0 +1,1 @@
+"""models stage of microg (see docs/architecture.md)."""

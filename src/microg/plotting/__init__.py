@@ -1,0 +1,1 @@
+"""plotting stage of microg (see docs/architecture.md)."""

@@ -1,0 +1,73 @@
+"""Figures of the reproduction (Figures 3 and 4 of the report) and PNG helpers."""
+
+from __future__ import annotations
+
+import base64
+import io
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.figure import Figure  # noqa: E402
+
+from microg.seed.reproduce import CurveSet  # noqa: E402
+from microg.units import G0  # noqa: E402
+
+__all__ = ["figure3", "figure4", "point_response_figure", "png_bytes", "png_data_uri"]
+
+
+def _curves(curves: CurveSet, which: str, title: str, ylabel: str) -> Figure:
+    fig, ax = plt.subplots(figsize=(7.5, 4.2), layout="constrained")
+    data = curves.u if which == "u" else curves.a
+    for w, y in zip(curves.omega, data, strict=True):
+        ax.plot(curves.timepts, y, lw=1.3, label=f"w = {w:g} rad/s")
+    ax.axhline(0.0, color="0.6", lw=0.6)
+    ax.set_xlabel("time t (s)")
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    return fig
+
+
+def figure3(curves: CurveSet) -> Figure:
+    """Figure 3: dimensionless displacement U(t) (Eq. 2.17) for several w."""
+    return _curves(curves, "u", "Figure 3 - displacement functions U(t), Eq. 2.17", "U(t)")
+
+
+def figure4(curves: CurveSet) -> Figure:
+    """Figure 4: dimensionless acceleration A(t) (Eq. 2.19) for several w."""
+    return _curves(curves, "a", "Figure 4 - acceleration functions A(t), Eq. 2.19", "A(t)")
+
+
+def point_response_figure(responses: dict, z_e_ft: float, z_a_ft: float) -> Figure:
+    """Acceleration at z_e from the crew force at z_a per case (Eq. 2.20b), in micro-g."""
+    fig, axes = plt.subplots(2, 2, figsize=(9.5, 6.0), layout="constrained", sharex=True)
+    for ax, (case, r) in zip(axes.ravel(), responses.items(), strict=False):
+        for j, a in enumerate(r.accel_modes, 1):
+            ax.plot(r.timepts, a / G0 * 1e6, lw=0.9, label=f"mode {j}")
+        ax.plot(r.timepts, r.accel / G0 * 1e6, "k", lw=1.1, label="sum")
+        ax.set_title(case, fontsize=10)
+        ax.grid(alpha=0.3)
+        ax.set_ylabel("micro-g")
+    axes[0, 0].legend(fontsize=8)
+    for ax in axes[1]:
+        ax.set_xlabel("time t (s)")
+    fig.suptitle(
+        f"Acceleration at z_e = {z_e_ft:.4g} ft, crew force at z_a = {z_a_ft:.4g} ft (Eq. 2.20b)"
+    )
+    return fig
+
+
+def png_bytes(fig: Figure, dpi: int = 110) -> bytes:
+    """Render ``fig`` to PNG bytes and close it."""
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=dpi)
+    plt.close(fig)
+    return buf.getvalue()
+
+
+def png_data_uri(png: bytes) -> str:
+    """A ``data:image/png;base64,...`` URI for embedding in HTML."""
+    return "data:image/png;base64," + base64.b64encode(png).decode("ascii")

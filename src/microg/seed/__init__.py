@@ -1,0 +1,1 @@
+"""seed stage of microg (see docs/architecture.md)."""

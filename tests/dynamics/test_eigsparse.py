@@ -1,0 +1,89 @@
+"""Tests of microg.dynamics.eigsparse: exact rigid modes plus deflated shift-invert."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from microg.dynamics.eigsparse import solve_sparse
+from microg.dynamics.rigid import rigid_basis
+from microg.errors import SolverError
+
+
+def chain(n: int, k: float = 1.0e4, m: float = 2.0, cut: int | None = None):
+    """Free-free chain of n equal masses and n-1 equal springs (spring ``cut`` removed)."""
+    kk = np.full(n - 1, k)
+    if cut is not None:
+        kk[cut] = 0.0
+    main = np.zeros(n)
+    main[:-1] += kk
+    main[1:] += kk
+    K = sp.diags([main, -kk, -kk], [0, -1, 1], format="csr")
+    M = sp.diags(np.full(n, m), format="csr")
+    return M, K
+
+
+def chain_exact(n: int, k: float = 1.0e4, m: float = 2.0) -> np.ndarray:
+    # free-free chain: omega_j^2 = 4 k / m sin^2(j pi / (2 n)), j = 0..n-1 (e.g. Meirovitch,
+    # Fundamentals of Vibrations, Sec. 8.6; the eigenvectors are cos((i + 1/2) j pi / n))
+    j = np.arange(n)
+    return np.sqrt(4 * k / m) * np.sin(j * np.pi / (2 * n))
+
+
+@pytest.mark.parametrize("dense_max", [0, 10**6], ids=["shift-invert", "dense"])
+def test_free_free_chain_matches_closed_form(dense_max):
+    n = 1500 if dense_max == 0 else 300
+    M, K = chain(n)
+    omega, phi, rigid = solve_sparse(M, K, np.ones((n, 1)), n_modes=12, dense_max=dense_max)
+    assert rigid.tolist() == [True] + [False] * 11
+    assert omega[0] == 0.0  # exact zero, not round-off
+    exact = chain_exact(n)[:12]
+    # lowest elastic eigenvalue ~ 4k/m (pi/2n)^2 is 2.2e-6 of the largest (4k/m): the
+    # eigenvalue round-off eps * lambda_max / lambda_1 ~ 1e-10 bounds the agreement
+    np.testing.assert_allclose(omega[1:], exact[1:], rtol=1e-9)
+    np.testing.assert_allclose(phi.T @ (M @ phi), np.eye(12), atol=1e-10)  # mass-normalised
+    # rigid mode is the uniform translation, normalised: 1/sqrt(total mass)
+    np.testing.assert_allclose(np.abs(phi[:, 0]), 1 / np.sqrt(2.0 * n), rtol=1e-12)
+    # residuals of the elastic modes: K phi = omega^2 M phi to round-off of K phi
+    res = K @ phi - (M @ phi) * omega**2
+    assert np.max(np.abs(res)) < 1e-9 * np.max(np.abs(K @ phi))
+
+
+@pytest.mark.parametrize("dense_max", [0, 10**6], ids=["shift-invert", "dense"])
+def test_mechanism_raises_naming_the_count(dense_max):
+    n = 2200 if dense_max == 0 else 300
+    M, K = chain(n, cut=100)  # two free pieces: one zero mode more than the rigid vector
+    with pytest.raises(SolverError, match="1 zero-frequency mode"):
+        solve_sparse(M, K, np.ones((n, 1)), n_modes=6, dense_max=dense_max)
+
+
+def test_candidate_not_annihilated_is_not_rigid():
+    n = 2500
+    M, K = chain(n)
+    K = (K + sp.diags(np.r_[1e-3, np.zeros(n - 1)])).tocsr()  # weak ground spring at node 0
+    x = np.ones((n, 1))
+    assert rigid_basis(M, K, x).shape[1] == 0
+    omega, _, rigid = solve_sparse(M, K, x, n_modes=4)
+    assert not rigid.any()
+    # Rayleigh quotient of the uniform vector, k_g / (n m), to first order in the tiny spring
+    np.testing.assert_allclose(omega[0] ** 2, 1e-3 / (2.0 * n), rtol=1e-3)
+
+
+def test_rigid_basis_detects_only_annihilated_combinations():
+    n = 2100
+    M, K = chain(n)
+    # candidates: a translation (rigid) and a linear ramp (strained); their span has one rigid
+    c = np.column_stack([np.ones(n), np.arange(n, dtype=float)])
+    b = rigid_basis(M, K, c)
+    assert b.shape[1] == 1
+    np.testing.assert_allclose(b.T @ (M @ b), [[1.0]], rtol=1e-12)
+    np.testing.assert_allclose(b[:, 0] / b[0, 0], 1.0, rtol=1e-10)
+
+
+def test_bad_input():
+    M, K = chain(10)
+    with pytest.raises(ValueError, match="not symmetric"):
+        solve_sparse(M, sp.triu(K).tocsr(), None)
+    with pytest.raises(ValueError, match="positive definite"):
+        solve_sparse(sp.diags(np.r_[0.0, np.ones(9)]).tocsr(), K, None)
