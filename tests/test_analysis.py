@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from microg.analysis import AXES, AnalysisOptions, Disturbance, run_analysis
+from microg._vectors import AXES
+from microg.analysis import AnalysisOptions, Disturbance, run_analysis
 from microg.dynamics.forces import crew_pushoff
 from microg.models.toml import load_station
 from microg.structure.ritz import build_ritz

@@ -18,10 +18,9 @@ import numpy as np
 from microg.dynamics.forces import ForceHistory
 from microg.dynamics.modes import Modes, solve_modes
 from microg.dynamics.response import PointResponse, generalized_force_vector, response_at_points
-from microg.environment.metrics import (
-    Assessment,
+from microg.environment.metrics import Assessment, assess
+from microg.environment.requirements import (
     Requirement,
-    assess,
     iss_requirement,
     report_flat_requirement,
 )
@@ -41,7 +40,6 @@ __all__ = [
     "Analysis",
     "run_analysis",
     "build_structure",
-    "AXES",
 ]
 
 #: the seed report's criterion: peak acceleration below 1e-5 g (Introduction)
@@ -49,12 +47,6 @@ REPORT_LIMIT_G = 1e-5
 
 #: largest number of output samples of one analysis (memory: ~100 bytes per sample and mode)
 MAX_SAMPLES = 2_000_000
-
-AXES: dict[str, np.ndarray] = {
-    "x": np.array([1.0, 0, 0]),
-    "y": np.array([0, 1.0, 0]),
-    "z": np.array([0, 0, 1.0]),
-}
 
 
 @dataclass(frozen=True)

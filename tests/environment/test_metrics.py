@@ -16,15 +16,19 @@ from microg.environment.metrics import (
     assess,
     band_rms,
     integrated_acceleration,
+)
+from microg.environment.requirements import (
     iss_requirement,
-    plot_integrated_acceleration,
-    plot_psd,
-    plot_third_octave,
-    plot_time_history,
     report_flat_requirement,
     third_octave_bands,
 )
 from microg.errors import InputError
+from microg.plotting.environment import (
+    plot_integrated_acceleration,
+    plot_psd,
+    plot_third_octave,
+    plot_time_history,
+)
 from microg.units import G0
 
 FS, T = 200.0, 100.0  # sampling rate Hz, record length s

@@ -26,6 +26,9 @@ SUBCOMMANDS: dict[str, str] = {
     "locate": "microg.cli.locate:locate",
     "optimize": "microg.cli.locate:optimize",
     "isolate": "microg.cli.isolate:isolate",
+    "assess": "microg.cli.assess:assess",
+    "quasi-steady": "microg.cli.quasisteady:quasi_steady",
+    "sweep": "microg.cli.sweep:sweep",
 }
 
 

@@ -149,8 +149,9 @@ def analyze(
     """
     from tqdm import tqdm
 
+    from microg._vectors import parse_direction
     from microg.analysis import AnalysisOptions, Disturbance, run_analysis
-    from microg.dynamics.forces import _parse_direction, parse_force_spec
+    from microg.dynamics.forces import parse_force_spec
     from microg.errors import InputError
     from microg.models.toml import load_station
     from microg.units import G0
@@ -185,7 +186,7 @@ def analyze(
     dists = []
     for i, spec in enumerate(forces):
         f = parse_force_spec(spec)
-        d = _parse_direction(directions[i if len(directions) == n else 0], "--direction")
+        d = parse_direction(directions[i if len(directions) == n else 0], "--direction")
         dists.append(Disturbance(f, at_points[i if len(at_points) == n else 0], d))
     opts = AnalysisOptions(
         disturbances=dists,

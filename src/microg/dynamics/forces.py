@@ -25,6 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
+from microg._vectors import parse_direction
 from microg.dynamics.crew import CrewPushoff
 from microg.errors import InputError
 from microg.units import LBF, parse_quantity
@@ -196,27 +197,6 @@ def piecewise_linear(
 # ---------------------------------------------------------------------------------------- CSV
 
 _UNIT_IN_HEADER = re.compile(r"^\s*([A-Za-z_]+)\s*(?:\[(.*)\]|\((.*)\))?\s*$")
-_AXES = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
-
-
-def _parse_direction(text: str, where: str) -> np.ndarray:
-    token = text.strip().lower().replace(" ", "")
-    sign = -1.0 if token.startswith("-") else 1.0
-    axis = token.lstrip("+-")
-    if axis in _AXES:
-        return sign * np.array(_AXES[axis])
-    parts = text.replace(";", " ").split()
-    try:
-        vec = np.array([float(p) for p in parts])
-    except ValueError:
-        vec = np.zeros(0)
-    if vec.shape != (3,) or not np.all(np.isfinite(vec)) or not np.any(vec):
-        raise InputError(
-            f"cannot read direction {text!r}",
-            where=where,
-            fix="write x, y, z, -x, ... or three numbers separated by spaces, e.g. '1 0 0'",
-        )
-    return vec / np.linalg.norm(vec)
 
 
 def _unit_scale(unit: str, dimension: str, where: str) -> float:
@@ -332,7 +312,7 @@ def from_csv(path: str | Path, *, name: str | None = None) -> ForceHistory:
         if "direction" in columns and columns["direction"] < len(cells):
             cell = cells[columns["direction"]].strip()
             if cell:
-                vec = _parse_direction(cell, f"{where}: direction")
+                vec = parse_direction(cell, f"{where}: direction")
                 if direction is None:
                     direction = vec
                 elif not np.allclose(vec, direction, rtol=0, atol=1e-12):

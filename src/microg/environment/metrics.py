@@ -20,37 +20,26 @@ Definitions (see docs/assessment.md):
 
 from __future__ import annotations
 
-import csv
 from dataclasses import dataclass, field
-from functools import lru_cache
-from importlib import resources
 from typing import Any
 
 import numpy as np
 from scipy import signal
 
+from microg.environment.requirements import BandTable, Requirement, iss_requirement
 from microg.errors import InputError
 from microg.units import G0
 
 __all__ = [
     "Spectrum",
-    "BandTable",
     "BandRMS",
-    "Requirement",
     "ThirdOctave",
     "IntegratedAcceleration",
     "Assessment",
     "acceleration_psd",
-    "third_octave_bands",
     "band_rms",
-    "iss_requirement",
-    "report_flat_requirement",
     "integrated_acceleration",
     "assess",
-    "plot_time_history",
-    "plot_psd",
-    "plot_third_octave",
-    "plot_integrated_acceleration",
 ]
 
 
@@ -75,15 +64,6 @@ class Spectrum:
 
 
 @dataclass(frozen=True)
-class BandTable:
-    """Frequency bands: centres and edges, Hz, each of shape (nb,)."""
-
-    center_hz: np.ndarray
-    lower_hz: np.ndarray
-    upper_hz: np.ndarray
-
-
-@dataclass(frozen=True)
 class BandRMS:
     """Band RMS of each axis.
 
@@ -99,26 +79,6 @@ class BandRMS:
     rms: np.ndarray
     coverage: np.ndarray
     resolved: np.ndarray
-
-
-@dataclass(frozen=True)
-class Requirement:
-    """A band-RMS acceleration limit, optionally with a peak limit.
-
-    Attributes
-    ----------
-    name : short name, e.g. ``iss``
-    bands : the 1/3-octave bands of the limit
-    limit_g : (nb,) band-RMS limit per axis, g
-    source : citation
-    peak_limit_g : optional limit on the peak acceleration (vector magnitude), g
-    """
-
-    name: str
-    bands: BandTable
-    limit_g: np.ndarray
-    source: str
-    peak_limit_g: float | None = None
 
 
 @dataclass(frozen=True)
@@ -333,34 +293,6 @@ def acceleration_psd(
     )
 
 
-def third_octave_bands(fmin_hz: float = 0.01, fmax_hz: float = 316.3, base: int = 10) -> BandTable:
-    """Standard 1/3-octave bands whose centres lie in [fmin_hz, fmax_hz].
-
-    Parameters
-    ----------
-    fmin_hz, fmax_hz : range of the band centres, Hz
-    base : 10 (centres 10^(n/10), edges centre * 10^(+-1/20)) or 2 (centres 2^(k/3), edges
-        centre * 2^(+-1/6), the table of the ISS requirement)
-    """
-    if not 0 < fmin_hz <= fmax_hz:
-        raise InputError("need 0 < fmin_hz <= fmax_hz", where="third_octave_bands")
-    if base == 10:
-        n = np.arange(
-            np.ceil(10 * np.log10(fmin_hz) - 1e-9), np.floor(10 * np.log10(fmax_hz) + 1e-9) + 1
-        )
-        center = 10.0 ** (n / 10)
-        half = 10.0 ** (1 / 20)
-    elif base == 2:
-        k = np.arange(
-            np.ceil(3 * np.log2(fmin_hz) - 1e-9), np.floor(3 * np.log2(fmax_hz) + 1e-9) + 1
-        )
-        center = 2.0 ** (k / 3)
-        half = 2.0 ** (1 / 6)
-    else:
-        raise InputError("base must be 10 or 2", where="third_octave_bands")
-    return BandTable(center_hz=center, lower_hz=center / half, upper_hz=center * half)
-
-
 def band_rms(spectrum: Spectrum, bands: BandTable) -> BandRMS:
     """RMS of each axis in each band: sqrt of the PSD integrated over the band (see module doc).
 
@@ -382,41 +314,6 @@ def band_rms(spectrum: Spectrum, bands: BandTable) -> BandRMS:
     coverage = (hi - lo) / (kept.upper_hz - kept.lower_hz)
     resolved = (kept.upper_hz - kept.lower_hz) >= df
     return BandRMS(kept, np.sqrt(np.maximum(power, 0.0)), coverage, resolved)
-
-
-# ---------------------------------------------------------------------------- requirements
-
-
-@lru_cache(maxsize=1)
-def iss_requirement() -> Requirement:
-    """ISS vibratory requirement, 1/3-octave band RMS per axis (``data/iss_requirement.csv``)."""
-    text = resources.files("microg").joinpath("data/iss_requirement.csv").read_text("utf-8")
-    lines = [ln for ln in text.splitlines() if ln.strip() and not ln.startswith("#")]
-    rows = list(csv.DictReader(lines))
-    col = {k: np.array([float(r[k]) for r in rows]) for k in rows[0] if k != "band"}
-    return Requirement(
-        name="iss",
-        bands=BandTable(col["center_hz"], col["lower_hz"], col["upper_hz"]),
-        limit_g=col["limit_ug"] * 1e-6,
-        source="ISS vibratory requirement (SSP 41000 curve as coded by NASA PIMS); "
-        "see microg/data/iss_requirement.csv",
-    )
-
-
-def report_flat_requirement(level_g: float = 1e-5, bands: BandTable | None = None) -> Requirement:
-    """The seed report's criterion: acceleration below ``level_g`` (1e-5 g) at the experiment.
-
-    Applied both as the peak limit and as a flat band-RMS limit on every band (default: the
-    base-10 1/3-octave bands with centres 0.01-316 Hz).
-    """
-    bands = bands or third_octave_bands(0.01, 316.3, base=10)
-    return Requirement(
-        name="report-1e-5g",
-        bands=bands,
-        limit_g=np.full(bands.center_hz.shape, level_g),
-        source="seed report, Introduction: experiments require acceleration below 1e-5 g",
-        peak_limit_g=level_g,
-    )
 
 
 # ----------------------------------------------------------------------------- integrals
@@ -537,89 +434,3 @@ def assess(
         integrated_max_magnitude_mps=integ.max_magnitude_mps,
         spectrum=spec,
     )
-
-
-# ---------------------------------------------------------------------------------- plots
-
-
-def _figure(title: str) -> Any:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=(7.5, 4.5), layout="constrained")
-    ax = fig.add_subplot()
-    if title:
-        ax.set_title(title)
-    return fig, ax
-
-
-def plot_time_history(
-    timepts: np.ndarray,
-    accel: np.ndarray,
-    *,
-    axes: tuple[str, ...] = ("x", "y", "z"),
-    title: str = "",
-) -> Any:
-    """Acceleration (m/s^2 in, plotted in micro-g) against time (s); returns a Figure."""
-    fig, ax = _figure(title or "Acceleration")
-    a = _as_axes(accel) / G0 * 1e6
-    for name, row in zip(axes, a, strict=False):
-        ax.plot(timepts, row, label=name, lw=0.8)
-    ax.set_xlabel("time [s]")
-    ax.set_ylabel("acceleration [micro-g]")
-    ax.grid(True, alpha=0.3)
-    ax.legend()
-    return fig
-
-
-def plot_psd(
-    spectrum: Spectrum, *, axes: tuple[str, ...] = ("x", "y", "z"), title: str = ""
-) -> Any:
-    """PSD in g^2/Hz against frequency (log-log); returns a Figure."""
-    fig, ax = _figure(title or f"PSD ({spectrum.method})")
-    f = spectrum.freq_hz[1:]
-    top = max(float(np.max(spectrum.psd[:, 1:])) / G0**2, 1e-300)
-    for name, row in zip(axes, spectrum.psd, strict=False):
-        ax.loglog(f, np.maximum(row[1:] / G0**2, 1e-300), label=name, lw=0.8)
-    ax.set_ylim(top * 1e-12, top * 10)  # 12 decades: below that is rounding noise
-    ax.set_xlabel("frequency [Hz]")
-    ax.set_ylabel("PSD [g^2/Hz]")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend()
-    return fig
-
-
-def plot_third_octave(assessment: Assessment, *, title: str = "") -> Any:
-    """1/3-octave band RMS per axis against the requirement (log-log, micro-g); returns a Figure."""
-    to = assessment.third_octave
-    fig, ax = _figure(title or f"1/3-octave band RMS vs {assessment.requirement}")
-    for name, row in zip(assessment.axes, to.rms_g, strict=False):
-        ax.loglog(to.center_hz, np.maximum(row * 1e6, 1e-12), marker="o", ms=3, lw=0.8, label=name)
-    ax.step(to.center_hz, to.limit_g * 1e6, where="mid", color="k", lw=1.5, label="limit")
-    ax.set_xlabel("band centre [Hz]")
-    ax.set_ylabel("band RMS [micro-g]")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend()
-    return fig
-
-
-def plot_integrated_acceleration(
-    timepts: np.ndarray,
-    accel: np.ndarray,
-    *,
-    window_s: float = 10.0,
-    axes: tuple[str, ...] = ("x", "y", "z"),
-    title: str = "",
-) -> Any:
-    """Integrated acceleration over sliding windows (m/s) against window start; returns a Figure."""
-    integ = integrated_acceleration(timepts, accel, window_s)
-    fig, ax = _figure(title or f"Integrated acceleration, {integ.window_s:g}-s windows")
-    for name, row in zip(axes, integ.delta_v, strict=False):
-        ax.plot(integ.t_start, row, label=name, lw=0.8)
-    ax.set_xlabel("window start [s]")
-    ax.set_ylabel("integral of acceleration [m/s]")
-    ax.grid(True, alpha=0.3)
-    ax.legend()
-    return fig

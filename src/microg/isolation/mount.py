@@ -16,7 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from microg.environment.metrics import Requirement, Spectrum, band_rms
+from microg.environment.metrics import Spectrum, band_rms
+from microg.environment.requirements import Requirement
 from microg.units import G0
 
 __all__ = ["mount_transmissibility", "MountChoice", "search_mount"]

@@ -34,6 +34,7 @@ from typing import Any
 
 import numpy as np
 
+from microg._vectors import parse_direction
 from microg.dynamics.crew import CrewPushoff, accel_amax
 from microg.dynamics.dense import solve_dense
 from microg.dynamics.modes import Modes
@@ -639,21 +640,6 @@ def _max_or_zero(x: np.ndarray, mask: np.ndarray) -> float:
     return float(np.max(np.abs(x[mask]))) if np.any(mask) else 0.0
 
 
-def _unit_direction(direction: np.ndarray | str) -> np.ndarray:
-    if isinstance(direction, str):
-        axes = {"x": 0, "y": 1, "z": 2}
-        if direction not in axes:
-            raise InputError(f"unknown direction {direction!r}", fix="use x, y or z")
-        d = np.zeros(3)
-        d[axes[direction]] = 1.0
-        return d
-    d = np.asarray(direction, float)
-    n = float(np.linalg.norm(d)) if d.shape == (3,) else 0.0
-    if not (np.isfinite(n) and n > 0):
-        raise InputError("direction must be a non-zero 3-vector", where="direction")
-    return d / n
-
-
 # --------------------------------------------------------------------------- the map
 
 
@@ -703,7 +689,7 @@ def acceleration_map(
         Length of the time window from the first breakpoint, s (default: to the last
         breakpoint plus three periods of the fundamental elastic mode).
     """
-    d = _unit_direction(direction)
+    d = parse_direction(direction, "direction")
     cp = structure.point(crew_point)
     omega = np.asarray(modes.omega, float)
     rigid = np.asarray(modes.rigid, bool)
@@ -985,7 +971,7 @@ def layout_objective(
         if name not in maps:
             known = ", ".join(sorted(maps))
             raise InputError(f"unknown point {name!r}", fix=f"known points: {known}")
-    d = PLANES[plane]["lateral"] if direction is None else _unit_direction(direction)
+    d = PLANES[plane]["lateral"] if direction is None else parse_direction(direction, "direction")
     el = elastic_mask(omega, rigid)
     pe = (maps[experiment_point].translation @ phi[:, el]).T @ d
     pa = (maps[crew_point].translation @ phi[:, el]).T @ d

@@ -12,7 +12,7 @@ from matplotlib.figure import Figure  # noqa: E402
 from microg import __version__  # noqa: E402
 from microg._io import to_jsonable  # noqa: E402
 from microg.analysis import Analysis  # noqa: E402
-from microg.environment.metrics import (  # noqa: E402
+from microg.plotting.environment import (  # noqa: E402
     plot_integrated_acceleration,
     plot_psd,
     plot_third_octave,
