@@ -1,0 +1,94 @@
+"""The one entry from a model to a :class:`~microg.structure.Structure`.
+
+Every path of microg (the main job, ``modes``, ``locate``, the layout optimiser, sweeps)
+discretises through :func:`discretize`, so one model gives one structure whatever the
+command.  Defaults live here, once:
+
+* ``method="fem"``: 3-D frame finite elements, :data:`DEFAULT_ELEMENTS` per beam;
+* ``method="ritz"``: assumed modes, ``plane="3d"`` (bending both ways, torsion, axial) or
+  the report's planar ``"xz"``/``"yz"`` model, :data:`DEFAULT_FUNCTIONS` function per beam;
+* ``gravity_gradient=False``: the free-free structure (rigid-body modes exactly zero).
+  With True the libration stiffness of Eqs. 2.27-2.28 / App. B-2 restrains the rotations.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from microg.errors import InputError
+from microg.structure.structure import Structure
+
+__all__ = [
+    "DEFAULT_ELEMENTS",
+    "DEFAULT_FUNCTIONS",
+    "METHODS",
+    "PLANES",
+    "discretize",
+]
+
+#: frame elements per beam (more where masses, points and joints cut a beam)
+DEFAULT_ELEMENTS = 10
+#: assumed functions per beam and deformation kind (1 is the report's model)
+DEFAULT_FUNCTIONS = 1
+METHODS = ("fem", "ritz")
+PLANES = ("3d", "xz", "yz")
+
+
+def discretize(
+    model: Any,
+    method: str = "fem",
+    *,
+    plane: str = "3d",
+    n: int | None = None,
+    gravity_gradient: bool = False,
+) -> Structure:
+    """Discretise a station model (or pass a modal model's structure through).
+
+    Parameters
+    ----------
+    model : Station, or an object with a ``to_structure()`` method (imported modal models)
+        The model, SI.
+    method : {"fem", "ritz"}
+        3-D frame finite elements, or assumed modes (Rayleigh-Ritz).
+    plane : {"3d", "xz", "yz"}
+        ``ritz`` only: the 3-D model or the report's planar model in that plane.
+    n : int, optional
+        Elements per beam (``fem``, default :data:`DEFAULT_ELEMENTS`) or functions per beam
+        (``ritz``, default :data:`DEFAULT_FUNCTIONS`).
+    gravity_gradient : bool
+        Add the gravity-gradient (libration) stiffness on the rigid rotations.
+
+    Returns
+    -------
+    Structure
+    """
+    to_structure = getattr(model, "to_structure", None)
+    if callable(to_structure):
+        structure = to_structure()
+        if not isinstance(structure, Structure):
+            raise TypeError("to_structure() must return a Structure")
+        return structure
+    if method not in METHODS:
+        raise InputError(f"unknown method {method!r}", where="method", fix="use fem or ritz")
+    if plane not in PLANES:
+        raise InputError(f"unknown plane {plane!r}", where="plane", fix="use 3d, xz or yz")
+    if method == "fem":
+        if plane != "3d":
+            raise InputError(
+                "applies to method ritz only (frame elements are always 3-D)",
+                where="plane",
+                fix="omit it, or use method ritz",
+            )
+        from microg.structure.fem import build_fem
+
+        return build_fem(
+            model, elements_per_beam=n or DEFAULT_ELEMENTS, gravity_gradient=gravity_gradient
+        )
+    from microg.structure.ritz import build_ritz
+
+    return build_ritz(
+        model,
+        None if plane == "3d" else plane,
+        n or DEFAULT_FUNCTIONS,
+        gravity_gradient=gravity_gradient,
+    )
