@@ -2,45 +2,98 @@
 
 Definitions (see docs/assessment.md):
 
-* PSD: one-sided power spectral density, (m/s^2)^2/Hz.  Default ``periodogram``: the whole record,
-  boxcar window, no detrending (a transient must not be tapered away; Parseval holds exactly:
-  ``sum(psd) * df`` is the mean square).  ``welch``: Hann window, segments of ``segment_s``
-  (default the whole record), 50 % overlap, no detrending.
+* Mean (DC): the record's mean per axis belongs to the quasi-steady regime.  It is reported
+  (``mean_accel_g_axis``) and removed before the spectrum; the power of the 0-Hz bin is excluded
+  from every band in any case.
+* PSD: one-sided power spectral density, (m/s^2)^2/Hz.  Default ``periodogram``: the whole
+  (demeaned) record, boxcar window (a transient must not be tapered away; Parseval holds
+  exactly: ``sum(psd) * df`` is the mean square).  ``welch``: Hann window, segments of
+  ``segment_s`` (default the whole record), 50 % overlap, each segment's mean removed; for long
+  stationary records.
 * Band RMS: ``sqrt(integral of the PSD over [lower, upper])``.  Each frequency bin's power
   ``psd_k * df`` is spread uniformly over its own interval ``[f_k - df/2, f_k + df/2]`` (clipped to
   ``[0, Nyquist]``); a bin straddling a band edge is shared in proportion.  So the band mean
   squares of contiguous bands add up exactly to the mean square of the record in their range
-  (Parseval).  A band narrower than one bin is flagged ``resolved = False``; a band that reaches
-  beyond the Nyquist frequency has ``coverage < 1``; bands wholly above Nyquist are left out.
-* Integrated acceleration: ``max over t of |int_t^{t+W} a dt|`` for windows of ``W = 10 s`` sliding
-  over the record (window starts at the samples, the end time interpolated in the running
-  trapezoidal integral); per axis and for the vector.  A record shorter than W is one window.
-* Margin: ``limit / band RMS`` (>= 1 passes, infinite for a zero band).
+  (Parseval).  Bands wholly above Nyquist are left out.
+* Resolved band: at least ``MIN_BINS`` (5) frequency bins in the band, a record at least
+  ``MIN_TIME_BANDWIDTH`` (5) times 1/bandwidth long, wholly below Nyquist (and below the data's
+  anti-alias cutoff when one is given).  Only resolved bands enter ``complies``; the others are
+  listed with the reason.
+* Integrated acceleration, two named quantities:
+  ``sliding`` (microg's, conservative): ``max over t of |int_t^{t+W} a dt|`` over the raw record,
+  windows of ``W = 10 s`` starting at every sample (end interpolated in the running trapezoidal
+  integral); ``pims`` (NASA PIMS ``file_trapz``): the record demeaned, cut into consecutive
+  blocks of ``ceil(W / dt)`` samples (an incomplete last block dropped), each block integrated
+  by the trapezoid rule.
+* Margin: ``limit / band RMS`` (>= 1 passes, infinite for a zero band; ``"inf"`` in JSON).
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from scipy import signal
 
-from microg.environment.requirements import BandTable, Requirement, iss_requirement
+from microg.environment.requirements import BandTable, Requirement
+from microg.environment.requirements import requirement as requirement_by_name
+from microg.environment.transient import (
+    TransientCriteria,
+    TransientVerdict,
+    judge_transient,
+    transient_criteria,
+)
 from microg.errors import InputError
 from microg.units import G0
 
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
 __all__ = [
+    "MIN_BINS",
+    "MIN_TIME_BANDWIDTH",
+    "MAX_SAMPLES",
     "Spectrum",
     "BandRMS",
     "ThirdOctave",
+    "WorstBand",
     "IntegratedAcceleration",
+    "IntegratedBlocks",
     "Assessment",
+    "json_number",
     "acceleration_psd",
     "band_rms",
     "integrated_acceleration",
+    "integrated_acceleration_pims",
     "assess",
 ]
+
+#: fewest frequency bins in a band for its RMS to be judged (see docs/assessment.md)
+MIN_BINS = 5.0
+#: fewest record lengths per 1/bandwidth for a band to be judged
+MIN_TIME_BANDWIDTH = 5.0
+#: largest record accepted by :func:`assess` (samples per axis; about 0.5 GB of work arrays)
+MAX_SAMPLES = 20_000_000
+
+
+def json_number(value: float) -> float | str | None:
+    """A float for JSON: finite as is, +-inf as the strings ``"inf"``/``"-inf"``, NaN as None.
+
+    ``"inf"`` is the documented representation of an infinite margin (a band with no power);
+    None means "not computed".
+    """
+    v = float(value)
+    if math.isfinite(v):
+        return v
+    if math.isnan(v):
+        return None
+    return "inf" if v > 0 else "-inf"
+
+
+def _numbers(a: np.ndarray) -> list[float | str | None]:
+    return [json_number(v) for v in np.ravel(a)]
 
 
 @dataclass(frozen=True)
@@ -54,6 +107,7 @@ class Spectrum:
     df_hz : bin spacing, Hz
     nyquist_hz : half the sampling rate, Hz
     method : "periodogram" or "welch"
+    record_s : length of the record the spectrum was taken from, s (None: ``1 / df_hz``)
     """
 
     freq_hz: np.ndarray
@@ -61,6 +115,12 @@ class Spectrum:
     df_hz: float
     nyquist_hz: float
     method: str
+    record_s: float | None = None
+
+    @property
+    def duration_s(self) -> float:
+        """The record length, s."""
+        return float(self.record_s) if self.record_s is not None else 1.0 / self.df_hz
 
 
 @dataclass(frozen=True)
@@ -72,13 +132,17 @@ class BandRMS:
     bands : the bands evaluated (those whose lower edge is below Nyquist)
     rms : (naxes, nb) band RMS, m/s^2
     coverage : (nb,) fraction of the band below the Nyquist frequency
-    resolved : (nb,) True where the band is at least one frequency bin wide
+    n_bins : (nb,) frequency bins in the band (below Nyquist), bandwidth / df
+    resolved : (nb,) True where the band may be judged (see the module doc)
+    reasons : (nb,) why a band is not resolved ("" where it is)
     """
 
     bands: BandTable
     rms: np.ndarray
     coverage: np.ndarray
     resolved: np.ndarray
+    n_bins: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    reasons: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -93,6 +157,8 @@ class ThirdOctave:
     margin: np.ndarray  # (naxes, nb)
     coverage: np.ndarray
     resolved: np.ndarray
+    n_bins: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    reasons: tuple[str, ...] = ()
 
     @property
     def worst_rms_g(self) -> np.ndarray:
@@ -100,9 +166,19 @@ class ThirdOctave:
         return self.rms_g.max(axis=0)
 
     @property
+    def rss_rms_g(self) -> np.ndarray:
+        """Root sum of squares of the axes' band RMS, (nb,), g (PIMS's ``v`` column)."""
+        return np.sqrt(np.sum(self.rms_g**2, axis=0))
+
+    @property
     def passes(self) -> np.ndarray:
         """(nb,) True where every axis is within the limit."""
         return np.all(self.rms_g <= self.limit_g, axis=0)
+
+    @property
+    def judged(self) -> np.ndarray:
+        """(nb,) the bands that enter the verdict (resolved)."""
+        return np.asarray(self.resolved, bool)
 
 
 @dataclass(frozen=True)
@@ -126,14 +202,43 @@ class IntegratedAcceleration:
 
 
 @dataclass(frozen=True)
+class IntegratedBlocks:
+    """PIMS's integrated acceleration: consecutive demeaned blocks, m/s.
+
+    Attributes
+    ----------
+    window_s : nominal block length, s
+    block_samples : samples per block, ``ceil(window_s / dt)`` as PIMS computes it
+    t_start : (nb,) block start times, s
+    delta_v : (naxes, nb) trapezoidal integral of each block, m/s
+    max_mps : (naxes,) max |delta_v| per axis, m/s (0 when there is no complete block)
+    max_magnitude_mps : max over blocks of the vector norm, m/s
+    """
+
+    window_s: float
+    block_samples: int
+    t_start: np.ndarray
+    delta_v: np.ndarray
+    max_mps: np.ndarray
+    max_magnitude_mps: float
+
+    @property
+    def n_blocks(self) -> int:
+        """Complete blocks in the record."""
+        return int(self.t_start.size)
+
+
+@dataclass(frozen=True)
 class WorstBand:
-    """The band and axis with the smallest margin."""
+    """The resolved band and axis with the smallest margin."""
 
     center_hz: float
     axis: str
     rms_g: float
     limit_g: float
     margin: float
+    lower_hz: float = float("nan")
+    upper_hz: float = float("nan")
 
 
 @dataclass(frozen=True)
@@ -144,16 +249,26 @@ class Assessment:
     ----------
     axes : axis names
     requirement : requirement name
-    peak_accel_g : peak of the acceleration vector magnitude, g
-    rms_accel_g : RMS of the vector magnitude over the record, g
-    peak_accel_g_axis, rms_accel_g_axis : (naxes,) per axis, g
-    third_octave : band RMS, limits and margins
-    complies : every band of every axis within its limit (and the peak within ``peak_limit_g``
-        when the requirement has one)
+    peak_accel_g : peak of the acceleration vector magnitude (raw record), g
+    rms_accel_g : RMS of the vector magnitude over the record (raw), g
+    peak_accel_g_axis, rms_accel_g_axis : (naxes,) per axis (raw), g
+    third_octave : band RMS, limits, margins, resolution of each band
+    complies : every resolved band of every axis within its limit, the peak within
+        ``peak_limit_g`` when the requirement has one, and every *verified* transient criterion
+        met; False when no band is resolved
     peak_limit_g : the requirement's peak limit, g, or None
-    worst_band : the band and axis with the smallest margin
-    integrated : integrated acceleration over sliding windows (maxima only kept here)
-    spectrum : the PSD used for the bands
+    worst_band : the resolved band and axis with the smallest margin (None: none resolved)
+    mean_accel_g_axis : (naxes,) record mean (the quasi-steady part), g
+    integrated_sliding : microg's sliding-window integral (raw record)
+    integrated_pims : PIMS's consecutive demeaned blocks (None: record shorter than a block)
+    transient : the transient criteria judged (None when none were asked for)
+    transient_basis : ``sliding`` or ``pims``: which integral and peak the criteria judge
+    requirement_source : citation of the requirement
+    record_s : record length ``n dt``, s
+    dt_s : sample interval, s
+    cutoff_hz : the data's anti-alias cutoff, Hz, or None
+    warnings : lines for the user (unresolved exceedances, unverified criteria exceeded, ...)
+    spectrum : the PSD used for the bands (of the demeaned record)
     """
 
     axes: tuple[str, ...]
@@ -166,49 +281,203 @@ class Assessment:
     complies: bool
     peak_limit_g: float | None
     worst_band: WorstBand | None
-    integrated_window_s: float
-    integrated_max_mps: np.ndarray
-    integrated_max_magnitude_mps: float
+    mean_accel_g_axis: np.ndarray
+    integrated_sliding: IntegratedAcceleration = field(repr=False)
+    integrated_pims: IntegratedBlocks | None = field(repr=False)
+    transient: TransientVerdict | None
+    transient_basis: str
+    requirement_source: str
+    record_s: float
+    dt_s: float
+    cutoff_hz: float | None
+    warnings: tuple[str, ...]
     spectrum: Spectrum = field(repr=False)
 
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-ready summary (the ``microg analyze --json`` observation layout)."""
+    # ------------------------------------------------------------------ derived quantities
+
+    @property
+    def mean_accel_g(self) -> float:
+        """Magnitude of the mean acceleration vector, g."""
+        return float(np.linalg.norm(self.mean_accel_g_axis))
+
+    @property
+    def verdict_bands_hz(self) -> np.ndarray:
+        """Centres of the bands the verdict covers (resolved), Hz."""
         to = self.third_octave
+        return to.center_hz[to.judged]
 
-        def clean(a: np.ndarray) -> list[float | None]:
-            return [float(v) if np.isfinite(v) else None for v in np.ravel(a)]
+    @property
+    def verdict_range_hz(self) -> tuple[float, float] | None:
+        """(lowest lower edge, highest upper edge) of the judged bands, Hz; None if none."""
+        to = self.third_octave
+        j = to.judged
+        if not np.any(j):
+            return None
+        return float(to.lower_hz[j].min()), float(to.upper_hz[j].max())
 
-        return {
+    @property
+    def unresolved_bands(self) -> list[dict[str, Any]]:
+        """The bands left out of the verdict: centre, edges and why."""
+        to = self.third_octave
+        return [
+            {
+                "center_hz": float(to.center_hz[i]),
+                "lower_hz": float(to.lower_hz[i]),
+                "upper_hz": float(to.upper_hz[i]),
+                "reason": to.reasons[i] if i < len(to.reasons) else "unresolved",
+            }
+            for i in np.nonzero(~to.judged)[0]
+        ]
+
+    # ---------------------------------------------------------------------------- outputs
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready summary (the ``microg analyze --json`` observation layout).
+
+        Keys carry units in their names; an infinite margin is the string ``"inf"``.
+        """
+        to = self.third_octave
+        ax = self.axes
+
+        def per_axis(a: np.ndarray) -> dict[str, float | str | None]:
+            return dict(zip(ax, _numbers(a), strict=True))
+
+        vr = self.verdict_range_hz
+        sl = self.integrated_sliding
+        out: dict[str, Any] = {
             "peak_accel_g": self.peak_accel_g,
             "rms_accel_g": self.rms_accel_g,
-            "peak_accel_g_axis": dict(zip(self.axes, clean(self.peak_accel_g_axis), strict=True)),
-            "rms_accel_g_axis": dict(zip(self.axes, clean(self.rms_accel_g_axis), strict=True)),
+            "peak_accel_g_axis": per_axis(self.peak_accel_g_axis),
+            "rms_accel_g_axis": per_axis(self.rms_accel_g_axis),
+            "mean_accel_g": self.mean_accel_g,
+            "mean_accel_g_axis": per_axis(self.mean_accel_g_axis),
+            "record": {
+                "duration_s": self.record_s,
+                "dt_s": self.dt_s,
+                "samples": int(round(self.record_s / self.dt_s)),
+                "psd_method": self.spectrum.method,
+                "df_hz": self.spectrum.df_hz,
+                "nyquist_hz": self.spectrum.nyquist_hz,
+                "cutoff_hz": self.cutoff_hz,
+                "demeaned": True,
+            },
             "third_octave": {
-                "center_hz": clean(to.center_hz),
-                "rms_g": clean(to.worst_rms_g),
-                "limit_g": clean(to.limit_g),
-                "margin": clean(to.margin.min(axis=0)),
-                "rms_g_axis": {a: clean(r) for a, r in zip(self.axes, to.rms_g, strict=True)},
+                "center_hz": _numbers(to.center_hz),
+                "lower_hz": _numbers(to.lower_hz),
+                "upper_hz": _numbers(to.upper_hz),
+                "rms_g": _numbers(to.worst_rms_g),
+                "limit_g": _numbers(to.limit_g),
+                "margin": _numbers(to.margin.min(axis=0) if to.margin.size else to.margin),
+                "rms_g_axis": {a: _numbers(r) for a, r in zip(ax, to.rms_g, strict=True)},
+                "margin_axis": {a: _numbers(m) for a, m in zip(ax, to.margin, strict=True)},
+                "rss_rms_g": _numbers(to.rss_rms_g),
                 "resolved": [bool(v) for v in to.resolved],
+                "n_bins": _numbers(to.n_bins),
+                "coverage": _numbers(to.coverage),
+                "unresolved_bands": self.unresolved_bands,
+                "verdict_bands_hz": _numbers(self.verdict_bands_hz),
+                "verdict_range_hz": None if vr is None else list(vr),
             },
             "requirement": self.requirement,
+            "requirement_source": self.requirement_source,
             "complies": bool(self.complies),
             "peak_limit_g": self.peak_limit_g,
             "worst_band": None
             if self.worst_band is None
             else {
                 "center_hz": self.worst_band.center_hz,
+                "lower_hz": self.worst_band.lower_hz,
+                "upper_hz": self.worst_band.upper_hz,
                 "axis": self.worst_band.axis,
                 "rms_g": self.worst_band.rms_g,
                 "limit_g": self.worst_band.limit_g,
-                "margin": self.worst_band.margin if np.isfinite(self.worst_band.margin) else None,
+                "margin": json_number(self.worst_band.margin),
             },
-            "integrated_accel": {
-                "window_s": self.integrated_window_s,
-                "max_mps_axis": dict(zip(self.axes, clean(self.integrated_max_mps), strict=True)),
-                "max_magnitude_mps": self.integrated_max_magnitude_mps,
+            "integrated_accel_sliding": {
+                "definition": "max over windows starting at every sample of |integral of the "
+                "raw acceleration over window_s| (microg, conservative)",
+                "window_s": sl.window_s,
+                "max_mps_axis": per_axis(sl.max_mps),
+                "max_magnitude_mps": sl.max_magnitude_mps,
             },
+            "integrated_accel_pims": None,
+            "transient": None
+            if self.transient is None
+            else {"basis": self.transient_basis, **self.transient.to_dict(ax)},
+            "warnings": list(self.warnings),
         }
+        pb = self.integrated_pims
+        if pb is not None:
+            out["integrated_accel_pims"] = {
+                "definition": "record demeaned, consecutive blocks of block_samples = "
+                "ceil(window_s / dt) samples, trapezoidal integral of each (NASA PIMS "
+                "file_trapz)",
+                "window_s": pb.window_s,
+                "block_samples": pb.block_samples,
+                "n_blocks": pb.n_blocks,
+                "max_mps_axis": per_axis(pb.max_mps),
+                "max_magnitude_mps": pb.max_magnitude_mps,
+            }
+        return out
+
+    def to_xarray(self) -> Any:
+        """Band RMS, margins, limits and PSD as an ``xarray.Dataset``.
+
+        Dims ``axis``, ``center_hz`` (bands) and ``freq_hz`` (PSD bins).
+
+        Units in each variable's ``units`` attribute; the verdict and the requirement in the
+        dataset's attributes.
+        """
+        import xarray as xr
+
+        to = self.third_octave
+        spec = self.spectrum
+        coords = {
+            "axis": list(self.axes),
+            "center_hz": ("center_hz", to.center_hz, {"units": "Hz"}),
+            "lower_hz": ("center_hz", to.lower_hz, {"units": "Hz"}),
+            "upper_hz": ("center_hz", to.upper_hz, {"units": "Hz"}),
+            "freq_hz": ("freq_hz", spec.freq_hz, {"units": "Hz"}),
+        }
+        data = {
+            "rms_g": (("axis", "center_hz"), to.rms_g, {"units": "g", "long_name": "band RMS"}),
+            "margin": (("axis", "center_hz"), to.margin, {"units": "1"}),
+            "limit_g": ("center_hz", to.limit_g, {"units": "g"}),
+            "rss_rms_g": ("center_hz", to.rss_rms_g, {"units": "g"}),
+            "resolved": ("center_hz", np.asarray(to.resolved, np.int8), {"units": "1"}),
+            "n_bins": ("center_hz", to.n_bins, {"units": "1"}),
+            "psd_g2_per_hz": (
+                ("axis", "freq_hz"),
+                spec.psd / G0**2,
+                {"units": "g^2/Hz", "method": spec.method},
+            ),
+            "peak_accel_g_axis": ("axis", self.peak_accel_g_axis, {"units": "g"}),
+            "rms_accel_g_axis": ("axis", self.rms_accel_g_axis, {"units": "g"}),
+            "mean_accel_g_axis": ("axis", self.mean_accel_g_axis, {"units": "g"}),
+        }
+        return xr.Dataset(
+            data,
+            coords=coords,
+            attrs={
+                "requirement": self.requirement,
+                "requirement_source": self.requirement_source,
+                "complies": int(self.complies),
+                "peak_accel_g": self.peak_accel_g,
+                "rms_accel_g": self.rms_accel_g,
+                "record_s": self.record_s,
+                "dt_s": self.dt_s,
+            },
+        )
+
+    def plot(self, kind: str = "third_octave") -> Figure:
+        """A figure of the assessment: ``third_octave`` (default) or ``psd``."""
+        from microg.plotting.environment import plot_psd, plot_third_octave
+
+        if kind == "third_octave":
+            return plot_third_octave(self)
+        if kind == "psd":
+            return plot_psd(self.spectrum, axes=self.axes)
+        raise InputError(f"unknown plot {kind!r}", where="kind", fix="use third_octave or psd")
 
 
 # ------------------------------------------------------------------------------- spectra
@@ -219,23 +488,36 @@ def _as_axes(accel: np.ndarray) -> np.ndarray:
     if a.ndim == 1:
         a = a[None, :]
     if a.ndim != 2:
-        raise InputError("acceleration must have shape (naxes, nt) or (nt,)", where="assess")
+        raise InputError("acceleration must have shape (naxes, nt) or (nt,)", where="accel")
     return a
 
 
 def _sample_rate(timepts: np.ndarray) -> float:
     t = np.asarray(timepts, dtype=float)
     if t.ndim != 1 or t.size < 4:
-        raise InputError("need at least 4 uniformly spaced samples", where="assess: timepts")
+        raise InputError("need at least 4 uniformly spaced samples", where="timepts")
+    if not np.all(np.isfinite(t)):
+        raise InputError("times are not all finite", where="timepts", fix="remove NaN/inf times")
     dt = np.diff(t)
     mean = (t[-1] - t[0]) / (t.size - 1)
     if not mean > 0 or np.max(np.abs(dt - mean)) > 1e-6 * mean:
         raise InputError(
             "a spectrum needs uniformly spaced output times",
-            where="assess: timepts",
+            where="timepts",
             fix="evaluate the response on a uniform grid (np.linspace)",
         )
     return 1.0 / mean
+
+
+def _check_finite(a: np.ndarray) -> None:
+    bad = ~np.isfinite(a)
+    if np.any(bad):
+        ax, i = np.unravel_index(int(np.argmax(bad)), a.shape)
+        raise InputError(
+            f"acceleration is not finite (row {ax}, sample {i})",
+            where="accel",
+            fix="remove or fill the NaN/inf samples before assessing",
+        )
 
 
 def acceleration_psd(
@@ -244,6 +526,7 @@ def acceleration_psd(
     *,
     method: str = "periodogram",
     segment_s: float | None = None,
+    demean: bool = True,
 ) -> Spectrum:
     """One-sided PSD of uniformly sampled accelerations.
 
@@ -251,9 +534,11 @@ def acceleration_psd(
     ----------
     timepts : (nt,) uniformly spaced times, s
     accel : (naxes, nt) or (nt,) acceleration, m/s^2
-    method : ``periodogram`` (whole record, boxcar, no detrend; exact Parseval) or ``welch``
-        (Hann window, 50 % overlap, no detrend)
+    method : ``periodogram`` (whole record, boxcar; exact Parseval) or ``welch`` (Hann window,
+        50 % overlap)
     segment_s : Welch segment length, s (default: the whole record)
+    demean : remove the record's mean first (``welch``: each segment's mean); the mean is the
+        quasi-steady part, reported separately by :func:`assess`
 
     Returns
     -------
@@ -262,9 +547,12 @@ def acceleration_psd(
     a = _as_axes(accel)
     fs = _sample_rate(timepts)
     n = a.shape[1]
+    if a.shape[1] != np.asarray(timepts).size:
+        raise InputError("timepts and accel have different lengths", where="accel")
     if method == "periodogram":
+        x = a - a.mean(axis=1, keepdims=True) if demean else a
         freq, psd = signal.periodogram(
-            a, fs=fs, window="boxcar", detrend=False, scaling="density", axis=-1
+            x, fs=fs, window="boxcar", detrend=False, scaling="density", axis=-1
         )
         nseg = n
     elif method == "welch":
@@ -272,7 +560,8 @@ def acceleration_psd(
         if not 4 <= nseg <= n:
             raise InputError(
                 f"Welch segment of {segment_s} s is not between 4 samples and the record",
-                where="assess: segment_s",
+                where="segment_s",
+                fix=f"give a segment between {4 / fs:.3g} s and {n / fs:.6g} s",
             )
         freq, psd = signal.welch(
             a,
@@ -280,40 +569,86 @@ def acceleration_psd(
             window="hann",
             nperseg=nseg,
             noverlap=nseg // 2,
-            detrend=False,
+            detrend="constant" if demean else False,
             scaling="density",
             axis=-1,
         )
     else:
         raise InputError(
-            f"unknown PSD method {method!r}", where="assess", fix="use periodogram or welch"
+            f"unknown PSD method {method!r}", where="psd_method", fix="use periodogram or welch"
         )
     return Spectrum(
-        freq_hz=freq, psd=np.atleast_2d(psd), df_hz=fs / nseg, nyquist_hz=fs / 2, method=method
+        freq_hz=freq,
+        psd=np.atleast_2d(psd),
+        df_hz=fs / nseg,
+        nyquist_hz=fs / 2,
+        method=method,
+        record_s=n / fs,
     )
 
 
-def band_rms(spectrum: Spectrum, bands: BandTable) -> BandRMS:
+def band_rms(
+    spectrum: Spectrum,
+    bands: BandTable,
+    *,
+    min_bins: float = MIN_BINS,
+    min_time_bandwidth: float = MIN_TIME_BANDWIDTH,
+    cutoff_hz: float | None = None,
+) -> BandRMS:
     """RMS of each axis in each band: sqrt of the PSD integrated over the band (see module doc).
+
+    The 0-Hz bin's power (the mean) is excluded from every band.
 
     Parameters
     ----------
     spectrum : a :class:`Spectrum`
     bands : bands, Hz; those whose lower edge is at or above Nyquist are dropped
+    min_bins : fewest frequency bins for a resolved band
+    min_time_bandwidth : fewest multiples of 1/bandwidth in the record for a resolved band
+    cutoff_hz : the data's anti-alias cutoff, Hz: bands reaching above it are unresolved
     """
     f, psd, df = spectrum.freq_hz, spectrum.psd, spectrum.df_hz
     nyq = spectrum.nyquist_hz
     keep = bands.lower_hz < nyq
     kept = BandTable(bands.center_hz[keep], bands.lower_hz[keep], bands.upper_hz[keep])
-    # bin k covers [f_k - df/2, f_k + df/2] clipped to [0, nyq]
+    # bin k covers [f_k - df/2, f_k + df/2] clipped to [0, nyq]; the DC bin carries no power
+    power_bins = psd * df
+    if f.size and f[0] == 0.0:
+        power_bins = power_bins.copy()
+        power_bins[:, 0] = 0.0
     edges = np.r_[0.0, np.minimum(f + df / 2, nyq)]
-    cum = np.concatenate([np.zeros((psd.shape[0], 1)), np.cumsum(psd * df, axis=1)], axis=1)
+    cum = np.concatenate([np.zeros((psd.shape[0], 1)), np.cumsum(power_bins, axis=1)], axis=1)
     lo = np.minimum(kept.lower_hz, nyq)
     hi = np.minimum(kept.upper_hz, nyq)
     power = np.array([np.interp(hi, edges, c) - np.interp(lo, edges, c) for c in cum])
-    coverage = (hi - lo) / (kept.upper_hz - kept.lower_hz)
-    resolved = (kept.upper_hz - kept.lower_hz) >= df
-    return BandRMS(kept, np.sqrt(np.maximum(power, 0.0)), coverage, resolved)
+    width = kept.upper_hz - kept.lower_hz
+    coverage = (hi - lo) / width
+    n_bins = (hi - lo) / df
+    record = spectrum.duration_s
+    welch = spectrum.method == "welch"
+    reasons = []
+    for w, nb, cov, top in zip(width, n_bins, coverage, kept.upper_hz, strict=True):
+        if cutoff_hz is not None and top > cutoff_hz:
+            reasons.append(f"above the data's cutoff frequency {cutoff_hz:.4g} Hz")
+        elif cov < 1.0:
+            reasons.append(f"reaches past the Nyquist frequency {nyq:.4g} Hz")
+        elif nb < min_bins:
+            what = "Welch segments" if welch else "a record"
+            reasons.append(
+                f"{nb:.2g} frequency bins (df = {df:.3g} Hz; {min_bins:g} needed: "
+                f"{what} of >= {min_bins / w:.4g} s)"
+            )
+        elif record * w < min_time_bandwidth:
+            reasons.append(
+                f"record of {record:.4g} s is shorter than {min_time_bandwidth:g}/bandwidth "
+                f"= {min_time_bandwidth / w:.4g} s"
+            )
+        else:
+            reasons.append("")
+    resolved = np.array([r == "" for r in reasons], bool)
+    return BandRMS(
+        kept, np.sqrt(np.maximum(power, 0.0)), coverage, resolved, n_bins, tuple(reasons)
+    )
 
 
 # ----------------------------------------------------------------------------- integrals
@@ -322,7 +657,10 @@ def band_rms(spectrum: Spectrum, bands: BandTable) -> BandRMS:
 def integrated_acceleration(
     timepts: np.ndarray, accel: np.ndarray, window_s: float = 10.0
 ) -> IntegratedAcceleration:
-    """Integral of the acceleration over sliding windows of ``window_s`` (NASA PIMS practice).
+    """Integral of the raw acceleration over sliding windows of ``window_s`` (microg's).
+
+    Windows start at every sample; the end is interpolated in the running trapezoidal
+    integral.  Conservative: the worst window anywhere, the mean kept.
 
     Parameters
     ----------
@@ -333,9 +671,9 @@ def integrated_acceleration(
     t = np.asarray(timepts, dtype=float)
     a = _as_axes(accel)
     if a.shape[1] != t.size or t.size < 2:
-        raise InputError("timepts and accel do not match", where="integrated_acceleration")
+        raise InputError("timepts and accel do not match", where="accel")
     if not window_s > 0:
-        raise InputError("window must be positive", where="integrated_acceleration")
+        raise InputError("window must be positive", where="window_s")
     cum = np.concatenate(
         [np.zeros((a.shape[0], 1)), np.cumsum(0.5 * (a[:, 1:] + a[:, :-1]) * np.diff(t), axis=1)],
         axis=1,
@@ -355,38 +693,126 @@ def integrated_acceleration(
     )
 
 
+def integrated_acceleration_pims(
+    timepts: np.ndarray,
+    accel: np.ndarray,
+    window_s: float = 10.0,
+    *,
+    sample_rate_hz: float | None = None,
+) -> IntegratedBlocks:
+    """PIMS's integrated acceleration: the demeaned record in consecutive blocks, m/s.
+
+    As ``file_trapz`` in ``transient/main.py`` of github.com/baluneboy/pims: the record's mean
+    is removed (over the whole record), ``nt = ceil(window_s / dt)`` with ``dt = 1 / fs`` (a
+    ratio within 1e-9 of an integer taken as that integer), consecutive blocks of ``nt``
+    samples, an incomplete last block dropped, and each block integrated by the trapezoid rule
+    with spacing ``dt``.
+
+    Parameters
+    ----------
+    timepts : (nt,) uniformly spaced times, s
+    accel : (naxes, nt) or (nt,) acceleration, m/s^2
+    window_s : nominal block length, s (PIMS: 10 s)
+    sample_rate_hz : the sampling rate, Hz (default: from ``timepts``; measured files give it)
+    """
+    a = _as_axes(accel)
+    fs = float(sample_rate_hz) if sample_rate_hz is not None else _sample_rate(timepts)
+    t = np.asarray(timepts, dtype=float)
+    if a.shape[1] != t.size:
+        raise InputError("timepts and accel do not match", where="accel")
+    if not window_s > 0:
+        raise InputError("window must be positive", where="window_s")
+    dt = 1.0 / fs
+    # PIMS: int(np.ceil(sec / dt)); a rate taken from rounded times must not turn an exact
+    # 1000.0000000001 into 1001, so a ratio within 1e-9 of an integer counts as that integer
+    ratio = window_s / dt
+    nt = max(1, int(np.ceil(ratio - 1e-9 * ratio)))
+    b = a - a.mean(axis=1, keepdims=True)
+    nblk = a.shape[1] // nt
+    blocks = b[:, : nblk * nt].reshape(a.shape[0], nblk, nt)
+    dv = np.trapezoid(blocks, dx=dt, axis=2) if nblk else np.zeros((a.shape[0], 0))
+    return IntegratedBlocks(
+        window_s=float(window_s),
+        block_samples=nt,
+        t_start=t[: nblk * nt : nt] if nblk else np.zeros(0),
+        delta_v=dv,
+        max_mps=np.max(np.abs(dv), axis=1) if nblk else np.zeros(a.shape[0]),
+        max_magnitude_mps=float(np.max(np.linalg.norm(dv, axis=0))) if nblk else 0.0,
+    )
+
+
 # ------------------------------------------------------------------------------ assessment
 
 
 def assess(
     timepts: np.ndarray,
     accel: np.ndarray,
-    requirement: Requirement | None = None,
+    requirement: Requirement | str | None = None,
     *,
     axes: tuple[str, ...] = ("x", "y", "z"),
     psd_method: str = "periodogram",
     segment_s: float | None = None,
     window_s: float = 10.0,
+    transient: TransientCriteria | str | None = "iss",
+    transient_basis: str = "sliding",
+    cutoff_hz: float | None = None,
+    sample_rate_hz: float | None = None,
+    min_bins: float = MIN_BINS,
+    min_time_bandwidth: float = MIN_TIME_BANDWIDTH,
 ) -> Assessment:
-    """Assess an acceleration history against a requirement (default: the ISS requirement).
+    """Assess an acceleration history against a requirement (default: ``iss``, PIMS's table).
 
     Parameters
     ----------
     timepts : (nt,) uniformly spaced times, s
     accel : (naxes, nt) or (nt,) acceleration, m/s^2
-    requirement : band limits (default :func:`iss_requirement`)
+    requirement : a :class:`Requirement` or its name
+        (:func:`~microg.environment.requirements.requirement`); default ``iss``
     axes : names of the rows of ``accel``
     psd_method, segment_s : see :func:`acceleration_psd`
-    window_s : window of the integrated acceleration, s (PIMS: 10 s)
+    window_s : window of the integrated accelerations, s (PIMS: 10 s)
+    transient : transient criteria set (name or object; None: none judged)
+    transient_basis : ``sliding`` (predictions: raw peak per axis, the sliding integral) or
+        ``pims`` (measurements: peak of the demeaned record, PIMS's block integral)
+    cutoff_hz : anti-alias cutoff of measured data, Hz (bands above it are unresolved)
+    sample_rate_hz : exact sampling rate, Hz, when known (PIMS's block length uses it)
+    min_bins, min_time_bandwidth : the resolution rule (see :func:`band_rms`)
     """
     a = _as_axes(accel)
+    t = np.asarray(timepts, dtype=float)
+    if a.shape[1] != t.size:
+        raise InputError(
+            f"timepts has {t.size} samples, accel {a.shape[1]}",
+            where="accel",
+            fix="give one acceleration sample per time",
+        )
+    if a.shape[1] > MAX_SAMPLES:
+        raise InputError(
+            f"{a.shape[1]:,} samples is more than {MAX_SAMPLES:,}",
+            where="accel",
+            fix="assess the record in shorter pieces (microg.environment.intervals)",
+        )
+    _check_finite(a)
+    if transient_basis not in ("sliding", "pims"):
+        raise InputError(
+            f"unknown transient basis {transient_basis!r}",
+            where="transient_basis",
+            fix="use sliding or pims",
+        )
     if len(axes) >= a.shape[0]:
         axes = tuple(axes)[: a.shape[0]]
     else:
         axes = tuple(f"axis{i}" for i in range(a.shape[0]))
-    req = requirement or iss_requirement()
-    spec = acceleration_psd(timepts, a, method=psd_method, segment_s=segment_s)
-    br = band_rms(spec, req.bands)
+    req = requirement_by_name(requirement if requirement is not None else "iss")
+    spec = acceleration_psd(t, a, method=psd_method, segment_s=segment_s)
+    dt = 1.0 / (2.0 * spec.nyquist_hz)
+    br = band_rms(
+        spec,
+        req.bands,
+        min_bins=min_bins,
+        min_time_bandwidth=min_time_bandwidth,
+        cutoff_hz=cutoff_hz,
+    )
     keep = req.bands.lower_hz < spec.nyquist_hz
     limit = req.limit_g[keep]
     rms_g = br.rms / G0
@@ -401,23 +827,81 @@ def assess(
         margin=margin,
         coverage=br.coverage,
         resolved=br.resolved,
+        n_bins=br.n_bins,
+        reasons=br.reasons,
     )
+    warnings: list[str] = []
     mag = np.linalg.norm(a, axis=0)
     peak = float(mag.max()) / G0
+    judged = br.resolved
     worst = None
-    if margin.size:
-        ax, band = np.unravel_index(np.argmin(margin), margin.shape)
+    if np.any(judged):
+        m = np.where(judged[None, :], margin, np.inf)
+        ax, band = np.unravel_index(int(np.argmin(m)), m.shape)
         worst = WorstBand(
             center_hz=float(third.center_hz[band]),
             axis=axes[ax],
             rms_g=float(rms_g[ax, band]),
             limit_g=float(limit[band]),
             margin=float(margin[ax, band]),
+            lower_hz=float(third.lower_hz[band]),
+            upper_hz=float(third.upper_hz[band]),
         )
-    complies = bool(np.all(rms_g <= limit))
+        complies = bool(np.all(rms_g[:, judged] <= limit[judged]))
+    else:
+        complies = False
+        warnings.append(
+            f"no band of {req.name} is resolved by this record ({a.shape[1] * dt:.4g} s at "
+            f"dt = {dt:.3g} s): the vibratory requirement cannot be judged, so it is not "
+            "called compliant; lengthen the record"
+        )
+    over = ~judged & np.any(rms_g > limit, axis=0)
+    for i in np.nonzero(over)[0]:
+        warnings.append(
+            f"band {third.center_hz[i]:.4g} Hz is not judged ({br.reasons[i]}), but its band "
+            f"RMS estimate {rms_g[:, i].max():.3g} g exceeds its limit {limit[i]:.3g} g"
+        )
     if req.peak_limit_g is not None:
         complies = complies and peak <= req.peak_limit_g
-    integ = integrated_acceleration(timepts, a, window_s)
+    sliding = integrated_acceleration(t, a, window_s)
+    pims = integrated_acceleration_pims(t, a, window_s, sample_rate_hz=sample_rate_hz)
+    pims_out: IntegratedBlocks | None = pims
+    if pims.n_blocks == 0:
+        pims_out = None
+        warnings.append(
+            f"record shorter than one {window_s:g}-s block: no PIMS integrated acceleration"
+        )
+    mean = a.mean(axis=1)
+    verdict = None
+    if transient is not None:
+        crit = transient_criteria(transient)
+        demeaned = a - mean[:, None]
+        if transient_basis == "sliding":
+            peak_axis, peak_mag = np.max(np.abs(a), axis=1), float(mag.max())
+        else:
+            peak_axis = np.max(np.abs(demeaned), axis=1)
+            peak_mag = float(np.max(np.linalg.norm(demeaned, axis=0)))
+        integ: dict[float, tuple[np.ndarray, float]] = {}
+        for w in crit.windows_s:
+            if transient_basis == "sliding":
+                s = sliding if w == window_s else integrated_acceleration(t, a, w)
+                integ[w] = (s.max_mps, s.max_magnitude_mps)
+            else:
+                p = (
+                    pims
+                    if w == window_s
+                    else integrated_acceleration_pims(t, a, w, sample_rate_hz=sample_rate_hz)
+                )
+                integ[w] = (p.max_mps, p.max_magnitude_mps)
+        verdict = judge_transient(
+            crit,
+            peak_axis=peak_axis,
+            peak_magnitude=peak_mag,
+            integrated=integ,
+            basis=transient_basis,
+        )
+        warnings.extend(verdict.warnings())
+        complies = complies and verdict.complies_verified
     return Assessment(
         axes=axes,
         requirement=req.name,
@@ -429,8 +913,15 @@ def assess(
         complies=complies,
         peak_limit_g=req.peak_limit_g,
         worst_band=worst,
-        integrated_window_s=integ.window_s,
-        integrated_max_mps=integ.max_mps,
-        integrated_max_magnitude_mps=integ.max_magnitude_mps,
+        mean_accel_g_axis=mean / G0,
+        integrated_sliding=sliding,
+        integrated_pims=pims_out,
+        transient=verdict,
+        transient_basis=transient_basis,
+        requirement_source=req.source,
+        record_s=a.shape[1] * dt,
+        dt_s=dt,
+        cutoff_hz=cutoff_hz,
+        warnings=tuple(warnings),
         spectrum=spec,
     )

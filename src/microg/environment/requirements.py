@@ -1,13 +1,23 @@
-"""Acceleration requirements: frequency bands and band-RMS limits (ISS, the seed report's).
+"""Acceleration requirements: frequency bands and band-RMS limits (ISS, SSP 41000, the report's).
 
 Every requirement is data with its source.  :class:`BandTable` and
 :func:`third_octave_bands` define the bands; :class:`Requirement` holds a limit per band
-(and optionally a peak limit).
+(and optionally a peak limit); :func:`requirement` looks one up by name.
+
+* ``iss`` (default): NASA PIMS's table of 46 one-third-octave bands exactly as PIMS codes it
+  (``get_oto_iss_req_steps`` in ``otorunhist/main.py`` of github.com/baluneboy/pims; see
+  ``microg/data/iss_requirement.csv`` for the commit).  It is not one formula: bands 1-10 and
+  39-46 have base-2 centres, bands 11-38 base-10 (IEC 61260) edges with nominal centres, and
+  the limits are 1.8 micro-g, 18 x nominal centre micro-g, 1.8 milli-g.
+* ``ssp41000``: the continuous SSP 41000 curve (1.6 micro-g for f <= 0.1 Hz, 16 f micro-g for
+  0.1 < f <= 100 Hz, 1600 micro-g above), evaluated at each band's centre on PIMS's bands.
+* ``flat`` (``report-1e-5g``): the seed report's 1e-5 g, as peak and flat band limit.
 """
 
 from __future__ import annotations
 
 import csv
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import lru_cache
 from importlib import resources
@@ -21,7 +31,11 @@ __all__ = [
     "Requirement",
     "third_octave_bands",
     "iss_requirement",
+    "ssp41000_limit_g",
+    "ssp41000_requirement",
     "report_flat_requirement",
+    "requirement",
+    "requirement_names",
 ]
 
 
@@ -60,8 +74,8 @@ def third_octave_bands(fmin_hz: float = 0.01, fmax_hz: float = 316.3, base: int 
     Parameters
     ----------
     fmin_hz, fmax_hz : range of the band centres, Hz
-    base : 10 (centres 10^(n/10), edges centre * 10^(+-1/20)) or 2 (centres 2^(k/3), edges
-        centre * 2^(+-1/6), the table of the ISS requirement)
+    base : 10 (centres 10^(n/10), edges centre * 10^(+-1/20), IEC 61260 exact) or 2 (centres
+        2^(k/3), edges centre * 2^(+-1/6))
     """
     if not 0 < fmin_hz <= fmax_hz:
         raise InputError("need 0 < fmin_hz <= fmax_hz", where="third_octave_bands")
@@ -82,9 +96,19 @@ def third_octave_bands(fmin_hz: float = 0.01, fmax_hz: float = 316.3, base: int 
     return BandTable(center_hz=center, lower_hz=center / half, upper_hz=center * half)
 
 
+def _data_comments(text: str) -> str:
+    """The ``#`` header of a shipped data file, joined into one line (its citation)."""
+    lines = [ln.lstrip("# ").strip() for ln in text.splitlines() if ln.startswith("#")]
+    return " ".join(ln for ln in lines if ln)
+
+
 @lru_cache(maxsize=1)
 def iss_requirement() -> Requirement:
-    """ISS vibratory requirement, 1/3-octave band RMS per axis (``data/iss_requirement.csv``)."""
+    """ISS vibratory requirement as NASA PIMS codes it (``data/iss_requirement.csv``).
+
+    46 one-third-octave bands, 0.0088-362 Hz, limit per axis in g RMS; source:
+    ``get_oto_iss_req_steps`` in ``otorunhist/main.py`` of github.com/baluneboy/pims.
+    """
     text = resources.files("microg").joinpath("data/iss_requirement.csv").read_text("utf-8")
     lines = [ln for ln in text.splitlines() if ln.strip() and not ln.startswith("#")]
     rows = list(csv.DictReader(lines))
@@ -92,9 +116,42 @@ def iss_requirement() -> Requirement:
     return Requirement(
         name="iss",
         bands=BandTable(col["center_hz"], col["lower_hz"], col["upper_hz"]),
-        limit_g=col["limit_ug"] * 1e-6,
-        source="ISS vibratory requirement (SSP 41000 curve as coded by NASA PIMS); "
-        "see microg/data/iss_requirement.csv",
+        limit_g=col["limit_g"],
+        source="NASA PIMS, get_oto_iss_req_steps() in otorunhist/main.py of "
+        "github.com/baluneboy/pims (ISS Microgravity Control Plan steps); "
+        "microg/data/iss_requirement.csv",
+    )
+
+
+def ssp41000_limit_g(freq_hz: np.ndarray | float) -> np.ndarray:
+    """The continuous SSP 41000 vibratory curve, g RMS per 1/3-octave band.
+
+    ``1.6e-6`` for f <= 0.1 Hz, ``16e-6 f`` for 0.1 < f <= 100 Hz, ``1.6e-3`` above
+    (``f`` = band centre frequency, Hz).
+
+    Parameters
+    ----------
+    freq_hz : band centre frequency, Hz
+    """
+    f = np.asarray(freq_hz, dtype=float)
+    return np.where(f <= 0.1, 1.6e-6, np.where(f <= 100.0, 16e-6 * f, 1.6e-3))
+
+
+@lru_cache(maxsize=1)
+def ssp41000_requirement() -> Requirement:
+    """The SSP 41000 curve, evaluated at the band centres of PIMS's 46 bands (name ``ssp41000``).
+
+    Stricter than PIMS's steps by 1.8/1.6 = 1.125 (PIMS's steps are the curve near each
+    band's upper edge, rounded); the bands are the same, so only the limits differ.
+    """
+    bands = iss_requirement().bands
+    return Requirement(
+        name="ssp41000",
+        bands=bands,
+        limit_g=ssp41000_limit_g(bands.center_hz),
+        source="SSP 41000 vibratory curve (1.6 ug to 0.1 Hz, 16 f ug to 100 Hz, 1600 ug "
+        "above), evaluated at the band centres of PIMS's table; "
+        "/work/shared/reference/domain.md",
     )
 
 
@@ -103,6 +160,11 @@ def report_flat_requirement(level_g: float = 1e-5, bands: BandTable | None = Non
 
     Applied both as the peak limit and as a flat band-RMS limit on every band (default: the
     base-10 1/3-octave bands with centres 0.01-316 Hz).
+
+    Parameters
+    ----------
+    level_g : the limit, g
+    bands : bands of the flat limit
     """
     bands = bands or third_octave_bands(0.01, 316.3, base=10)
     return Requirement(
@@ -112,3 +174,35 @@ def report_flat_requirement(level_g: float = 1e-5, bands: BandTable | None = Non
         source="seed report, Introduction: experiments require acceleration below 1e-5 g",
         peak_limit_g=level_g,
     )
+
+
+_NAMES: dict[str, Callable[[], Requirement]] = {
+    "iss": iss_requirement,
+    "ssp41000": ssp41000_requirement,
+    "flat": report_flat_requirement,
+    "report-1e-5g": report_flat_requirement,
+}
+
+
+def requirement_names() -> tuple[str, ...]:
+    """Names :func:`requirement` accepts."""
+    return tuple(_NAMES)
+
+
+def requirement(name: str | Requirement) -> Requirement:
+    """The requirement called ``name`` (``iss``, ``ssp41000``, ``flat`` = ``report-1e-5g``).
+
+    Parameters
+    ----------
+    name : a name of :func:`requirement_names`, or a :class:`Requirement` (returned as is)
+    """
+    if isinstance(name, Requirement):
+        return name
+    key = str(name).strip().lower()
+    if key not in _NAMES:
+        raise InputError(
+            f"unknown requirement {name!r}",
+            where="requirement",
+            fix=f"use one of: {', '.join(_NAMES)}",
+        )
+    return _NAMES[key]()

@@ -1,7 +1,8 @@
-"""Figures of acceleration assessments: time history, PSD, 1/3-octave bands, integrals.
+"""Figures of acceleration assessments: time history, PSD, 1/3-octave bands, integrals, overlay.
 
 Figures are built with ``matplotlib.figure.Figure`` (no pyplot, no backend switch), so
-they work in scripts, servers and notebooks alike.
+they work in scripts, servers and notebooks alike.  Requirement limits are drawn as steps on
+the band edges (each band's limit from its lower to its upper edge), as PIMS draws them.
 """
 
 from __future__ import annotations
@@ -9,31 +10,42 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from matplotlib.figure import Figure
 
 from microg.environment.metrics import (
     Assessment,
     Spectrum,
+    ThirdOctave,
     _as_axes,
     integrated_acceleration,
 )
 from microg.units import G0
 
 __all__ = [
+    "limit_steps",
     "plot_time_history",
     "plot_psd",
     "plot_third_octave",
     "plot_integrated_acceleration",
+    "plot_overlay",
 ]
 
 
-def _figure(title: str) -> Any:
-    from matplotlib.figure import Figure
-
+def _figure(title: str) -> tuple[Figure, Any]:
     fig = Figure(figsize=(7.5, 4.5), layout="constrained")
     ax = fig.add_subplot()
     if title:
         ax.set_title(title)
     return fig, ax
+
+
+def limit_steps(
+    lower_hz: np.ndarray, upper_hz: np.ndarray, limit: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """x, y of a step line: each band's ``limit`` from its lower to its upper edge (Hz)."""
+    x = np.column_stack([lower_hz, upper_hz]).ravel()
+    y = np.repeat(np.asarray(limit, float), 2)
+    return x, y
 
 
 def plot_time_history(
@@ -42,7 +54,7 @@ def plot_time_history(
     *,
     axes: tuple[str, ...] = ("x", "y", "z"),
     title: str = "",
-) -> Any:
+) -> Figure:
     """Acceleration (m/s^2 in, plotted in micro-g) against time (s); returns a Figure."""
     fig, ax = _figure(title or "Acceleration")
     a = _as_axes(accel) / G0 * 1e6
@@ -57,11 +69,11 @@ def plot_time_history(
 
 def plot_psd(
     spectrum: Spectrum, *, axes: tuple[str, ...] = ("x", "y", "z"), title: str = ""
-) -> Any:
-    """PSD in g^2/Hz against frequency (log-log); returns a Figure."""
+) -> Figure:
+    """PSD in g^2/Hz against frequency (log-log, the 0-Hz bin left out); returns a Figure."""
     fig, ax = _figure(title or f"PSD ({spectrum.method})")
     f = spectrum.freq_hz[1:]
-    top = max(float(np.max(spectrum.psd[:, 1:])) / G0**2, 1e-300)
+    top = max(float(np.max(spectrum.psd[:, 1:], initial=0.0)) / G0**2, 1e-300)
     for name, row in zip(axes, spectrum.psd, strict=False):
         ax.loglog(f, np.maximum(row[1:] / G0**2, 1e-300), label=name, lw=0.8)
     ax.set_ylim(top * 1e-12, top * 10)  # 12 decades: below that is rounding noise
@@ -72,17 +84,44 @@ def plot_psd(
     return fig
 
 
-def plot_third_octave(assessment: Assessment, *, title: str = "") -> Any:
-    """1/3-octave band RMS per axis against the requirement (log-log, micro-g); returns a Figure."""
+def _bands_on(ax: Any, to: ThirdOctave, axes: tuple[str, ...], style: str, label: str) -> None:
+    """Band RMS per axis, micro-g; resolved bands filled, unresolved hollow."""
+    res = np.asarray(to.resolved, bool)
+    for name, row in zip(axes, to.rms_g, strict=False):
+        y = np.maximum(row * 1e6, 1e-12)
+        (ln,) = ax.loglog(to.center_hz, y, style, ms=3, lw=0.8, label=f"{label}{name}")
+        if np.any(~res):
+            ax.plot(
+                to.center_hz[~res],
+                y[~res],
+                "o",
+                ms=5,
+                mfc="none",
+                color=ln.get_color(),
+                label="_unresolved",
+            )
+
+
+def plot_third_octave(assessment: Assessment, *, title: str = "") -> Figure:
+    """1/3-octave band RMS per axis against the requirement's steps (micro-g); returns a Figure.
+
+    Hollow markers: bands not resolved by the record (not in the verdict); shaded: the range
+    the verdict covers.
+    """
     to = assessment.third_octave
     fig, ax = _figure(title or f"1/3-octave band RMS vs {assessment.requirement}")
-    for name, row in zip(assessment.axes, to.rms_g, strict=False):
-        ax.loglog(to.center_hz, np.maximum(row * 1e6, 1e-12), marker="o", ms=3, lw=0.8, label=name)
-    ax.step(to.center_hz, to.limit_g * 1e6, where="mid", color="k", lw=1.5, label="limit")
-    ax.set_xlabel("band centre [Hz]")
+    _bands_on(ax, to, assessment.axes, "o-", "")
+    x, y = limit_steps(to.lower_hz, to.upper_hz, to.limit_g * 1e6)
+    ax.plot(x, y, color="k", lw=1.5, label="limit")
+    vr = assessment.verdict_range_hz
+    if vr is not None:
+        ax.axvspan(vr[0], vr[1], color="0.85", alpha=0.4, lw=0, label="judged bands")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("frequency [Hz] (markers at band centres, limit on band edges)")
     ax.set_ylabel("band RMS [micro-g]")
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend()
+    ax.legend(fontsize=8)
     return fig
 
 
@@ -93,14 +132,57 @@ def plot_integrated_acceleration(
     window_s: float = 10.0,
     axes: tuple[str, ...] = ("x", "y", "z"),
     title: str = "",
-) -> Any:
+) -> Figure:
     """Integrated acceleration over sliding windows (m/s) against window start; returns a Figure."""
     integ = integrated_acceleration(timepts, accel, window_s)
-    fig, ax = _figure(title or f"Integrated acceleration, {integ.window_s:g}-s windows")
+    fig, ax = _figure(title or f"Integrated acceleration, sliding {integ.window_s:g}-s windows")
     for name, row in zip(axes, integ.delta_v, strict=False):
         ax.plot(integ.t_start, row, label=name, lw=0.8)
     ax.set_xlabel("window start [s]")
     ax.set_ylabel("integral of acceleration [m/s]")
     ax.grid(True, alpha=0.3)
     ax.legend()
+    return fig
+
+
+def plot_overlay(
+    prediction: Assessment,
+    measurement: Assessment,
+    *,
+    labels: tuple[str, str] = ("prediction", "measurement"),
+    title: str = "",
+) -> Figure:
+    """A prediction and a measurement at one site: band RMS per axis and PSD; returns a Figure.
+
+    Top: 1/3-octave band RMS of both (solid: the first, dashed: the second) against the
+    first's requirement steps.  Bottom: their PSDs, worst axis by RMS, in g^2/Hz.
+    """
+    fig = Figure(figsize=(7.5, 7.0), layout="constrained")
+    ax1, ax2 = fig.subplots(2, 1)
+    ax1.set_title(title or f"{labels[0]} and {labels[1]} vs {prediction.requirement}")
+    _bands_on(ax1, prediction.third_octave, prediction.axes, "o-", f"{labels[0]} ")
+    _bands_on(ax1, measurement.third_octave, measurement.axes, "s--", f"{labels[1]} ")
+    to = prediction.third_octave
+    x, y = limit_steps(to.lower_hz, to.upper_hz, to.limit_g * 1e6)
+    ax1.plot(x, y, color="k", lw=1.5, label="limit")
+    ax1.set_xscale("log")
+    ax1.set_yscale("log")
+    ax1.set_xlabel("frequency [Hz]")
+    ax1.set_ylabel("band RMS [micro-g]")
+    ax1.grid(True, which="both", alpha=0.3)
+    ax1.legend(fontsize=7, ncol=2)
+    for a, lab, style in ((prediction, labels[0], "-"), (measurement, labels[1], "--")):
+        s = a.spectrum
+        i = int(np.argmax(np.sum(s.psd[:, 1:], axis=1)))
+        ax2.loglog(
+            s.freq_hz[1:],
+            np.maximum(s.psd[i, 1:] / G0**2, 1e-300),
+            style,
+            lw=0.8,
+            label=f"{lab} ({a.axes[i]})",
+        )
+    ax2.set_xlabel("frequency [Hz]")
+    ax2.set_ylabel("PSD [g^2/Hz]")
+    ax2.grid(True, which="both", alpha=0.3)
+    ax2.legend(fontsize=8)
     return fig
