@@ -1,66 +1,101 @@
 """The main job: a station's microgravity environment under crew disturbances.
 
-``run_analysis`` loads a model, discretises it, solves the free-free modes, applies the
+:func:`analyze` is the public entry (``microg.analyze``); ``microg analyze`` on the command
+line parses its options and calls it.  It loads or takes a model, discretises it through
+:func:`microg.structure.discretize.discretize`, solves the free-free modes, applies the
 disturbances (exact piecewise-linear modal response, damped modes, rigid-body modes
-included), assesses the acceleration at the observed points against the ISS vibratory
-requirement, and recommends isolation where a point does not comply.  It returns one
-:class:`Analysis` object; the CLI and the HTML report only read it.
+included), assesses the acceleration at the observed points against a requirement, and
+advises isolation where a point does not comply.  It returns one :class:`Analysis`; the
+CLI and the HTML report only read it.
+
+Every default lives here, once (:data:`DEFAULTS`).  Inputs that would make a verdict
+meaningless are refused (:class:`~microg.errors.InputError` naming the parameter); inputs
+that make it shaky put a line in :attr:`Analysis.warnings`.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+import datetime as _dt
+import hashlib
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field, replace
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from microg.dynamics.forces import ForceHistory
+from microg._vectors import axis_name, parse_direction
+from microg.dynamics.forces import ForceHistory, parse_force_spec
 from microg.dynamics.modes import Modes, solve_modes
-from microg.dynamics.response import PointResponse, generalized_force_vector, response_at_points
-from microg.environment.metrics import Assessment, assess
+from microg.dynamics.response import (
+    PointResponse,
+    generalized_force_vector,
+    modal_pwl_response,
+)
+from microg.environment.metrics import Assessment, acceleration_psd, assess, band_rms
 from microg.environment.requirements import (
+    BandTable,
     Requirement,
     iss_requirement,
     report_flat_requirement,
 )
 from microg.errors import InputError
-from microg.models.station import Station
+from microg.isolation.advise import IsolationAdvice, advise_isolation
+from microg.structure.discretize import discretize
 from microg.structure.structure import Structure
-from microg.units import G0, IN, LB, LBF
+from microg.units import G0, LB, parse_quantity
 
 if TYPE_CHECKING:
-    from microg.isolation.design import MountDesign
-    from microg.isolation.mount import MountChoice
+    from matplotlib.figure import Figure
 
 __all__ = [
+    "DEFAULTS",
+    "REPORT_LIMIT_G",
     "Disturbance",
     "AnalysisOptions",
-    "IsolationAdvice",
+    "ModeContributions",
+    "Observation",
     "Analysis",
+    "analyze",
     "run_analysis",
-    "build_structure",
 ]
 
 #: the seed report's criterion: peak acceleration below 1e-5 g (Introduction)
 REPORT_LIMIT_G = 1e-5
-
 #: largest number of output samples of one analysis (memory: ~100 bytes per sample and mode)
 MAX_SAMPLES = 2_000_000
+#: interval over which the requirement's band RMS is stated (PIMS judges 100-s intervals)
+REQUIREMENT_INTERVAL_S = 100.0
+#: modes solved for sparse (frame) models when ``n_modes`` is not given
+DEFAULT_SPARSE_MODES = 60
+#: the defaults of :func:`analyze` and ``microg analyze``, SI
+DEFAULTS: dict[str, Any] = {
+    "force": "crew-pushoff",
+    "direction": "x",
+    "method": "fem",
+    "plane": "3d",
+    "damping": 0.005,
+    "max_freq_hz": 10.0,
+    "duration_s": 200.0,
+    "dt_s": 0.01,
+    "requirement": "iss",
+    "package_mass_kg": 1000.0 * LB,
+    "gravity_gradient": False,
+}
 
 
 @dataclass(frozen=True)
 class Disturbance:
-    """A force history applied at a named point in a direction.
+    """A force history applied at a named point.
 
     Attributes
     ----------
     force : ForceHistory
-        Breakpoints (s, N); its own direction, if any, wins over ``direction``.
+        Breakpoints (s, N).
     point : str
         Named point of the model where it acts.
     direction : ndarray (3,)
-        Unit vector of the force in the station frame.
+        Unit vector of the force in the station frame (a CSV force's own direction wins).
     """
 
     force: ForceHistory
@@ -69,15 +104,14 @@ class Disturbance:
 
     @property
     def unit_direction(self) -> np.ndarray:
-        """The direction used: the force's own (CSV) direction if it has one."""
+        """The direction used: the force's own (CSV) direction if it has one, unit length."""
         d = self.force.direction if self.force.direction is not None else self.direction
-        d = np.asarray(d, float)
-        return d / np.linalg.norm(d)
+        return parse_direction(np.asarray(d, float), "direction")
 
 
 @dataclass(frozen=True)
 class AnalysisOptions:
-    """Everything ``microg analyze`` needs besides the model (SI).
+    """Everything the main job needs besides the model, SI (defaults: :data:`DEFAULTS`).
 
     Attributes
     ----------
@@ -86,85 +120,166 @@ class AnalysisOptions:
     observe : sequence of str
         Named points to assess.
     method : str
-        ``"fem"`` (3-D frame elements) or ``"ritz"`` (the report's planar assumed modes).
+        ``"fem"`` (3-D frame elements) or ``"ritz"`` (assumed modes).
     plane : str
-        ``"3d"`` (default), ``"xz"`` or ``"yz"`` for ``ritz``.
-    elements_per_beam : int
-        Finite elements per beam (``fem``); assumed functions per beam (``ritz``).
+        ``"3d"``, or ``"xz"``/``"yz"`` for the report's planar ``ritz`` model.
+    n : int or None
+        Elements per beam (fem) or functions per beam (ritz); None: the discretisation's
+        default.
+    n_modes : int or None
+        Modes to solve for sparse models (None: :data:`DEFAULT_SPARSE_MODES`).
     zeta : float
         Modal damping ratio of the elastic modes.
     max_freq_hz : float
-        Elastic modes up to this frequency are kept (the rigid-body modes always).
-    duration : float
+        Elastic modes up to this frequency enter the response (rigid-body modes always).
+    duration_s : float
         Length of the output record, s.
-    dt : float
+    dt_s : float
         Output sample interval, s.
     requirement : str
-        ``"iss"`` (ISS vibratory requirement) or ``"flat"`` (the report's 1e-5 g).
-    package_mass : float
+        Name of the band requirement (``"iss"`` or ``"flat"``).
+    package_mass_kg : float
         Experiment package mass for the isolation advice, kg.
     absorber_mu : float or None
         Absorber mass ratio for the isolation advice (None: spring only).
+    isolation : bool
+        Advise isolation where a point does not comply.
+    gravity_gradient : bool
+        Restrain the rigid rotations by the gravity-gradient (libration) stiffness.
     """
 
     disturbances: Sequence[Disturbance]
     observe: Sequence[str]
-    method: str = "fem"
-    plane: str = "3d"
-    elements_per_beam: int = 10
-    zeta: float = 0.005
-    max_freq_hz: float = 10.0
-    duration: float = 200.0
-    dt: float = 0.01
-    requirement: str = "iss"
-    package_mass: float = 1000.0 * LB
+    method: str = DEFAULTS["method"]
+    plane: str = DEFAULTS["plane"]
+    n: int | None = None
+    n_modes: int | None = None
+    zeta: float = DEFAULTS["damping"]
+    max_freq_hz: float = DEFAULTS["max_freq_hz"]
+    duration_s: float = DEFAULTS["duration_s"]
+    dt_s: float = DEFAULTS["dt_s"]
+    requirement: str = DEFAULTS["requirement"]
+    package_mass_kg: float = DEFAULTS["package_mass_kg"]
     absorber_mu: float | None = None
+    isolation: bool = True
+    gravity_gradient: bool = DEFAULTS["gravity_gradient"]
 
 
 @dataclass(frozen=True)
-class IsolationAdvice:
-    """Isolation recommendation for one observed point.
+class ModeContributions:
+    """What each mode contributes at one observed point: which mode to stiffen or detune.
 
     Attributes
     ----------
-    point : str
-    needed : bool
-        False when the point complies without isolation.
-    band_hz : tuple of float
-        Lowest and highest band edges where the requirement is exceeded, Hz.
-    target_ma : float
-        Largest acceleration magnification that brings every exceeding band to its limit.
-    design : MountDesign or None
-        :class:`microg.isolation.design.MountDesign`: the report's rule (M_a over the
-        exceeding band), with stiffness, natural frequency and sag.
-    note : str
-    package_accel : ndarray (3, nt) or None
-        What the isolated package feels: the exact response of the designed mount (the same
-        mount on each axis) to the point's acceleration history, m/s^2.
-    isolated : Assessment or None
-        The package's acceleration assessed against the same requirement.
-    peak_stroke : float or None
-        Largest package motion relative to the mount over the axes (rattle space), m.
-    mount : MountChoice or None
-        :class:`microg.isolation.mount.MountChoice`: the recommended spring-damper mount
-        from the whole-spectrum screen (``found`` False when none complies).
+    mode : ndarray of int (k,)
+        Mode numbers (1-based, as in the modes table) of the modes in the response.
+    freq_hz : ndarray (k,)
+        Their frequencies, Hz.
+    at_peak_g : ndarray (k,)
+        Each mode's acceleration at the instant of the peak, projected on the peak's
+        direction, g.  They sum to the peak magnitude.
+    own_peak_g : ndarray (k,)
+        Each mode's own largest acceleration magnitude over the record, g.
+    worst_band_rms_g : ndarray (k,) or None
+        Each mode's band RMS in the worst band on the worst axis, g (None when no band).
+    worst_band_hz : float or None
+        Centre of that band, Hz.
+    worst_axis : str or None
     """
 
-    point: str
-    needed: bool
-    band_hz: tuple[float, float] | None
-    target_ma: float | None
-    design: MountDesign | None
-    note: str
-    package_accel: np.ndarray | None = None
-    isolated: Assessment | None = None
-    peak_stroke: float | None = None
-    mount: MountChoice | None = None
+    mode: np.ndarray
+    freq_hz: np.ndarray
+    at_peak_g: np.ndarray
+    own_peak_g: np.ndarray
+    worst_band_rms_g: np.ndarray | None
+    worst_band_hz: float | None
+    worst_axis: str | None
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready table, one row per mode."""
+        rows = []
+        for i in range(self.mode.size):
+            row: dict[str, Any] = {
+                "mode": int(self.mode[i]),
+                "freq_hz": float(self.freq_hz[i]),
+                "at_peak_g": float(self.at_peak_g[i]),
+                "own_peak_g": float(self.own_peak_g[i]),
+            }
+            if self.worst_band_rms_g is not None:
+                row["worst_band_rms_g"] = float(self.worst_band_rms_g[i])
+            rows.append(row)
+        return {"worst_band_hz": self.worst_band_hz, "worst_axis": self.worst_axis, "modes": rows}
+
+
+@dataclass(frozen=True)
+class Observation:
+    """The result at one observed point.
+
+    Attributes
+    ----------
+    name : str
+    response : PointResponse
+        Displacement, velocity and acceleration (3 axes, SI) at the output times.
+    assessment : Assessment
+        Peak, RMS, bands, margins, integrated acceleration against the requirement.
+    isolation : IsolationAdvice
+    contributions : ModeContributions
+    interval : dict
+        Band margins over consecutive intervals of :data:`REQUIREMENT_INTERVAL_S`.
+    """
+
+    name: str
+    response: PointResponse
+    assessment: Assessment
+    isolation: IsolationAdvice
+    contributions: ModeContributions
+    interval: Mapping[str, Any]
+
+    @property
+    def peak_accel_g(self) -> float:
+        """Peak of the acceleration magnitude, g."""
+        return float(self.assessment.peak_accel_g)
+
+    @property
+    def complies(self) -> bool:
+        """The band verdict at this point."""
+        return bool(self.assessment.complies)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The observation block of ``microg analyze --json``."""
+        d = self.assessment.to_dict()
+        d["report_criterion"] = {
+            "limit_g": REPORT_LIMIT_G,
+            "peak_within": bool(self.assessment.peak_accel_g <= REPORT_LIMIT_G),
+        }
+        d["requirement_interval"] = dict(self.interval)
+        d["mode_contributions"] = self.contributions.to_dict()
+        d["isolation"] = self.isolation.to_dict()
+        return d
+
+    def to_xarray(self) -> Any:
+        """The acceleration history as an ``xarray.DataArray`` (dims axis, time; m/s^2)."""
+        import xarray as xr
+
+        r = self.response
+        return xr.DataArray(
+            r.acceleration,
+            dims=("axis", "time"),
+            coords={"axis": ["x", "y", "z"], "time": r.timepts},
+            name="acceleration",
+            attrs={"units": "m/s^2", "point": self.name, "time_units": "s"},
+        )
+
+    def plot(self) -> Figure:
+        """Acceleration history and 1/3-octave bands against the requirement (a Figure)."""
+        from microg.plotting.analysis import observation_figure
+
+        return observation_figure(self)
 
 
 @dataclass(frozen=True)
 class Analysis:
-    """Result of :func:`run_analysis`.
+    """Result of :func:`analyze`.
 
     Attributes
     ----------
@@ -176,12 +291,15 @@ class Analysis:
         All computed modes (``used`` marks those in the response).
     used : ndarray of bool
         Modes kept for the response (rigid + elastic up to ``max_freq_hz``).
-    responses : dict of str to PointResponse
-        Motion of each observed point (3 axes, SI).
-    assessments : dict of str to Assessment
-    isolation : dict of str to IsolationAdvice
+    observations : dict of str to Observation
     timepts : ndarray
         Output times, s.
+    requirement : Requirement
+    warnings : list of str
+        What makes the verdict shaky; shown in the JSON, the console and the report.
+    notes : list of str
+    meta : dict
+        Provenance: microg version, UTC time, command, model path and sha256.
     """
 
     model: str
@@ -189,291 +307,678 @@ class Analysis:
     structure: Structure
     modes: Modes
     used: np.ndarray
-    responses: dict[str, PointResponse]
-    assessments: dict[str, Assessment]
-    isolation: dict[str, IsolationAdvice]
+    observations: dict[str, Observation]
     timepts: np.ndarray
+    requirement: Requirement
     warnings: list[str] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
+    meta: dict[str, Any] = field(default_factory=dict)
 
-    def to_dict(self) -> dict:
-        """The ``microg analyze --json`` contract."""
+    @property
+    def complies(self) -> bool:
+        """Every observed point meets the band requirement."""
+        return all(o.complies for o in self.observations.values())
+
+    @property
+    def responses(self) -> dict[str, PointResponse]:
+        """Response of each observed point."""
+        return {n: o.response for n, o in self.observations.items()}
+
+    @property
+    def assessments(self) -> dict[str, Assessment]:
+        """Assessment of each observed point."""
+        return {n: o.assessment for n, o in self.observations.items()}
+
+    @property
+    def isolation(self) -> dict[str, IsolationAdvice]:
+        """Isolation advice of each observed point."""
+        return {n: o.isolation for n, o in self.observations.items()}
+
+    def to_dict(self) -> dict[str, Any]:
+        """The ``microg analyze --json`` contract (documented in docs/assessment.md)."""
         modes = self.modes.to_dict()
         for row, used in zip(modes["modes"], self.used, strict=True):
             row["used"] = bool(used)
-        obs = {}
-        for name, a in self.assessments.items():
-            d = a.to_dict()
-            d["isolation"] = _advice_dict(self.isolation[name])
-            # the seed report's single-number criterion, beside the band-by-band one
-            d["report_criterion"] = {
-                "limit_g": REPORT_LIMIT_G,
-                "peak_within": bool(a.peak_accel_g <= REPORT_LIMIT_G),
-            }
-            obs[name] = d
+        o = self.options
         return {
+            "meta": dict(self.meta),
             "model": self.model,
             "method": self.structure.method,
             "plane": self.structure.plane,
             "modes": modes,
-            "disturbances": [
-                {
-                    "name": d.force.name,
-                    "at": d.point,
-                    "direction": d.unit_direction,
-                    "peak_force_N": float(np.max(np.abs(d.force.force))),
-                    "impulse_Ns": float(d.force.impulse()),
-                }
-                for d in self.options.disturbances
-            ],
-            "damping": self.options.zeta,
-            "requirement": self.options.requirement,
-            "record": {"duration_s": self.options.duration, "dt_s": self.options.dt},
-            "observations": obs,
-            "complies": all(a.complies for a in self.assessments.values()),
+            "disturbances": [_disturbance_dict(d) for d in o.disturbances],
+            "damping": o.zeta,
+            "requirement": self.requirement.name,
+            "requirement_source": self.requirement.source,
+            "record": {
+                "duration_s": o.duration_s,
+                "dt_s": o.dt_s,
+                "nyquist_hz": 0.5 / o.dt_s,
+                "max_freq_hz": o.max_freq_hz,
+            },
+            "observations": {n: ob.to_dict() for n, ob in self.observations.items()},
+            "complies": self.complies,
+            "report_criterion": {
+                "limit_g": REPORT_LIMIT_G,
+                "peak_within": all(
+                    ob.assessment.peak_accel_g <= REPORT_LIMIT_G
+                    for ob in self.observations.values()
+                ),
+            },
             "warnings": list(self.warnings),
             "notes": list(self.notes),
         }
 
+    def plot(self) -> Figure:
+        """The modes used and the peak at each observed point (a Figure)."""
+        from microg.plotting.analysis import analysis_figure
 
-def _advice_dict(adv: IsolationAdvice) -> dict[str, Any]:
+        return analysis_figure(self)
+
+
+def _disturbance_dict(d: Disturbance) -> dict[str, Any]:
+    f = d.force
+    direction = d.unit_direction
     out: dict[str, Any] = {
-        "needed": adv.needed,
-        "band_hz": adv.band_hz,
-        "target_Ma": adv.target_ma,
-        "note": adv.note,
-        "design": None,
+        "name": f.name,
+        "at": d.point,
+        "direction": direction,
+        "direction_axis": axis_name(direction),
+        "peak_force_N": float(np.max(np.abs(f.force))),
+        "impulse_Ns": float(f.impulse()),
+        "end_s": float(f.timepts[-1]),
+        "final_force_N": float(f.force[-1]),
     }
-    if adv.isolated is not None:
-        iso = adv.isolated
-        out["isolated"] = {
-            "peak_accel_g": iso.peak_accel_g,
-            "rms_accel_g": iso.rms_accel_g,
-            "complies": bool(iso.complies),
-            "peak_stroke_m": adv.peak_stroke,
-            "worst_band": None
-            if iso.worst_band is None
-            else {"center_hz": iso.worst_band.center_hz, "margin": iso.worst_band.margin},
-        }
-    if adv.mount is not None:
-        mc = adv.mount
-        out["recommended_mount"] = {
-            "found": bool(mc.found),
-            "k1_N_per_m": mc.k1,
-            "k1_lbf_per_in": mc.k1 * IN / LBF,
-            "zeta1": mc.zeta1,
-            "c1_N_s_per_m": mc.c1,
-            "freq_hz_n": mc.freq_hz_n,
-            "screen_min_margin": mc.min_margin,
-        }
-    d = adv.design
-    if d is not None:
-        out["design"] = {
-            k: getattr(d, k)
-            for k in (
-                "k1",
-                "k1_lbf_per_in",
-                "omega_n",
-                "freq_hz_n",
-                "achieved_Ma",
-                "sag_1g",
-                "mu",
-                "k",
-            )
-            if hasattr(d, k)
-        }
-        out["design"]["units"] = "k1 N/m, omega_n rad/s, freq_hz_n Hz, sag_1g m"
-        out["design"]["rule"] = "report Section 4.2: M_a <= target over the exceeding band"
+    params = getattr(f, "params", None)
+    if params:
+        out["params"] = dict(params)
     return out
 
 
-def build_structure(station: Station, method: str, plane: str, n: int) -> Structure:
-    """Discretise ``station`` by ``method`` ("fem": n elements per beam; "ritz": n functions)."""
-    if method == "fem":
-        from microg.structure.fem import build_fem
-
-        return build_fem(station, elements_per_beam=n)
-    if method == "ritz":
-        from microg.structure.ritz import build_ritz
-
-        return build_ritz(station, None if plane == "3d" else plane, n, gravity_gradient=False)
-    raise InputError(f"unknown method {method!r}", where="--method", fix="use fem or ritz")
+# ----------------------------------------------------------------------------- inputs
 
 
-def _advise(
-    name: str,
-    a: Assessment,
-    opts: AnalysisOptions,
-    response: PointResponse,
-    requirement: Requirement,
-) -> IsolationAdvice:
-    from microg.isolation.design import design_mount
-    from microg.isolation.mount import search_mount
-    from microg.isolation.timedomain import IsolatorModel, package_response
+def _si(value: Any, dimension: str, where: str, unit_system: str | None) -> float:
+    """A float (SI) or a string (with a unit, or bare in the model's unit system) -> SI."""
+    from microg.units import DIMENSIONS
 
-    if a.complies:
-        return IsolationAdvice(name, False, None, None, None, "complies without isolation")
-    to = a.third_octave
-    margin = to.margin.min(axis=0)
-    bad = np.isfinite(margin) & (margin < 1.0)
-    if not np.any(bad):
-        return IsolationAdvice(
-            name,
-            True,
-            None,
-            None,
-            None,
-            "exceeds the peak limit only: a passive mount cannot help a transient's peak "
-            "without knowing its spectrum",
-        )
-    lo = float(to.lower_hz[bad].min())
-    hi = float(to.upper_hz[bad].max())
-    target = float(max(margin[bad].min(), 1e-6))
-    note = (
-        f"bands {lo:.3g}-{hi:.3g} Hz exceed the requirement; the mount must attenuate them by "
-        f"{1 / target:.3g}x (M_a <= {target:.3g})"
-    )
+    if isinstance(value, bool):
+        raise InputError(f"expected a {dimension}, got {value!r}", where=where)
+    if isinstance(value, int | float | np.integer | np.floating):
+        v = float(value)
+        if not np.isfinite(v):
+            raise InputError(f"{value!r} is not a finite number", where=where)
+        return v
+    default = _bare_unit(dimension, unit_system) or DIMENSIONS[dimension] or None
+    return parse_quantity(str(value), dimension, where=where, default_unit=default)
+
+
+def _bare_unit(dimension: str, unit_system: str | None) -> str | None:
+    """Unit of a bare number of ``dimension`` in a model's unit system (None: SI)."""
+    if unit_system is None:
+        return None
     try:
-        design = design_mount(
-            opts.package_mass,
-            (2 * np.pi * lo, 2 * np.pi * hi),
-            min(target, 1.0),
-            mu=opts.absorber_mu,
-        )
-    except InputError as exc:
-        return IsolationAdvice(name, True, (lo, hi), target, None, f"{note}; no design: {exc}")
-    # the report's rule ignores the mount's own resonance, which a transient excites below
-    # the exceeding band: screen spring-damper mounts on the whole spectrum, then verify the
-    # choice with the exact time-domain response
-    choice = search_mount(a.spectrum, requirement, opts.package_mass, 10.0 * design.k1)
-    if choice.found:
-        mount = IsolatorModel(m1=opts.package_mass, k1=choice.k1, c1=choice.c1)
-    else:
-        mount = IsolatorModel(
-            m1=opts.package_mass,
-            k1=design.k1,
-            m2=design.m2 or 0.0,
-            k2=design.k2 or 0.0,
-            c=design.c or 0.0,
-        )
-    runs = [package_response(mount, response.timepts, row) for row in response.acceleration]
-    pkg = np.array([r.package_accel for r in runs])
-    isolated = assess(response.timepts, pkg, requirement)
-    stroke = max(r.peak_stroke for r in runs)
-    if choice.found:
-        note += (
-            f"; the report's rule gives k1 = {design.k1:.4g} N/m, but its undamped resonance "
-            f"at {design.freq_hz_n:.3g} Hz is excited by the transient. Recommended: k1 = "
-            f"{choice.k1:.4g} N/m ({choice.k1 * IN / LBF:.4g} lbf/in) with damping ratio "
-            f"{choice.zeta1:g} (c1 = {choice.c1:.4g} N s/m, f_n = {choice.freq_hz_n:.3g} Hz)"
-        )
-    else:
-        note += (
-            f"; no spring-damper mount screened ({choice.screened}) makes it comply "
-            f"(best margin {choice.min_margin:.3g}): active isolation (ARIS-class) is needed"
-        )
-    verdict = "complies" if isolated.complies else "does not comply"
-    note += (
-        f"; verified in the time domain: the package {verdict} "
-        f"(peak {isolated.peak_accel_g:.3g} g, stroke {stroke:.3g} m)"
-    )
-    return IsolationAdvice(
-        name, True, (lo, hi), target, design, note, pkg, isolated, stroke, choice
-    )
+        from microg.models.toml import UNIT_SYSTEMS
+    except ImportError:  # pragma: no cover - the model loader defines it
+        return None
+    table = UNIT_SYSTEMS.get(unit_system, {})
+    return table.get(dimension)
 
 
-def run_analysis(
-    station: Station,
-    opts: AnalysisOptions,
+def _as_list(value: Any) -> list[Any]:
+    if value is None:
+        return []
+    if isinstance(value, str | ForceHistory | np.ndarray):
+        return [value]
+    if isinstance(value, Sequence):
+        return list(value)
+    return [value]
+
+
+def _directions(value: Any) -> list[Any]:
+    """Directions as a list; a single 3-vector of numbers is one direction."""
+    if value is None:
+        return []
+    if isinstance(value, str | np.ndarray):
+        return [value]
+    items = list(value)
+    if len(items) == 3 and all(
+        isinstance(c, int | float | np.integer | np.floating) for c in items
+    ):
+        return [items]
+    return items
+
+
+def _forces(force: Any) -> list[ForceHistory]:
+    specs = _as_list(force) or [DEFAULTS["force"]]
+    out = []
+    for i, spec in enumerate(specs):
+        where = "force" if len(specs) == 1 else f"force[{i}]"
+        if isinstance(spec, ForceHistory):
+            out.append(spec)
+        elif isinstance(spec, str | Path):
+            out.append(parse_force_spec(str(spec), where=where))
+        else:
+            raise InputError(
+                f"cannot use {spec!r} as a force",
+                where=where,
+                fix="give a spec string (crew-pushoff, a library name, a CSV path) or a "
+                "ForceHistory",
+            )
+    return out
+
+
+def _point_names(model: Any) -> list[tuple[str, str]]:
+    """(name, kind) of the model's named points."""
+    pts = getattr(model, "points", ())
+    if isinstance(pts, Mapping):
+        return [(n, getattr(p, "kind", "point")) for n, p in pts.items()]
+    return [(p.name, getattr(p, "kind", "point")) for p in pts]
+
+
+def _check_points(names: Sequence[str], known: Sequence[str], where: str) -> None:
+    for p in names:
+        if p not in known:
+            raise InputError(
+                f"unknown point {p!r}", where=where, fix=f"known points: {', '.join(known)}"
+            )
+
+
+def _load(model: Any) -> Any:
+    if isinstance(model, str | Path):
+        try:
+            from microg.models.load import load_model
+        except ImportError:
+            from microg.models.toml import load_station as load_model
+        return load_model(model)
+    return model
+
+
+def _requirement(name: str | Requirement) -> Requirement:
+    if isinstance(name, Requirement):
+        return name
+    try:
+        from microg.environment.requirements import requirement as by_name
+    except ImportError:
+        by_name = None
+    if by_name is not None:
+        return by_name(name)
+    if name == "iss":
+        return iss_requirement()
+    if name in ("flat", "report-1e-5g"):
+        return report_flat_requirement()
+    raise InputError(f"unknown requirement {name!r}", where="requirement", fix="use iss or flat")
+
+
+def analyze(
+    model: Any = "ioc",
+    force: Any = None,
+    at: str | Sequence[str] | None = None,
+    direction: Any = None,
+    observe: str | Sequence[str] | None = None,
     *,
+    method: str = DEFAULTS["method"],
+    plane: str = DEFAULTS["plane"],
+    n: int | None = None,
+    n_modes: int | None = None,
+    damping: float = DEFAULTS["damping"],
+    max_freq: float | str = DEFAULTS["max_freq_hz"],
+    duration: float | str = DEFAULTS["duration_s"],
+    dt: float | str = DEFAULTS["dt_s"],
+    requirement: str | Requirement = DEFAULTS["requirement"],
+    package_mass: float | str | None = None,
+    absorber_mu: float | None = None,
+    isolation: bool = True,
+    gravity_gradient: bool = DEFAULTS["gravity_gradient"],
     progress: Callable[[str], None] | None = None,
+    command: str | None = None,
 ) -> Analysis:
-    """Run the main job on ``station`` (see the module docstring).
+    """The main job: modes, response to disturbances, compliance, isolation advice.
 
     Parameters
     ----------
-    station : Station
+    model : Station, modal model, str or Path
+        A model object, a model file path or a shipped model name (default ``"ioc"``).
+    force : str, ForceHistory, or a list of them
+        Spec strings as on the command line (``"crew-pushoff"``,
+        ``"crew-pushoff:f0=40lbf,t1=0.5s"``, a library activity, a CSV path) or force
+        objects.  Default: the report's push-off.
+    at : str or list of str
+        Named point where each force acts (one for all, or one per force).  Default: the
+        model's first point of kind ``crew``.
+    direction : str, 3 numbers, or a list of them
+        Force direction(s): ``"x"``, ``"-z"``, ``"1 0 0"``, ``[0, 1, 0]``.  Default ``"x"``.
+    observe : str or list of str
+        Named points to assess.  Default: the model's points of kind ``experiment`` (all
+        points when it has none).
+    method : {"fem", "ritz"}
+    plane : {"3d", "xz", "yz"}
+    n : int, optional
+        Elements (fem) or functions (ritz) per beam.
+    n_modes : int, optional
+        Modes solved for sparse models.
+    damping : float
+        Modal damping ratio of the elastic modes, 0 <= zeta < 1.
+    max_freq : float (Hz) or str
+        Elastic modes up to this frequency enter the response.
+    duration, dt : float (s) or str
+        Record length and output sample interval.
+    requirement : str or Requirement
+        ``"iss"`` (the ISS vibratory requirement as PIMS codes it) or ``"flat"`` (the report's
+        1e-5 g); or a Requirement object.
+    package_mass : float (kg) or str
+        Experiment package mass for the isolation advice (default 1000 lb).
+    absorber_mu : float, optional
+        Absorber mass ratio for the isolation advice.
+    isolation : bool
+        Advise isolation where a point does not comply.
+    gravity_gradient : bool
+        Restrain the rigid rotations by gravity gradient (libration).
+    progress : callable, optional
+        Called with a stage name as each stage starts.
+    command : str, optional
+        The command line, for the provenance record.
+
+    Returns
+    -------
+    Analysis
+
+    Notes
+    -----
+    A float is SI; a string is parsed, with its unit or, when bare, in the model's unit
+    system.  Errors name the parameter (``duration``, ``observe``, ``force[1]``...).
+    """
+    mdl = _load(model)
+    units = getattr(mdl, "unit_system", None)
+    forces = _forces(force)
+    nf = len(forces)
+    points = _point_names(mdl)
+    known = [p for p, _ in points]
+    at_list = [str(a) for a in _as_list(at)]
+    if not at_list:
+        crew = [p for p, k in points if k == "crew"]
+        if not crew:
+            raise InputError(
+                "the model has no crew point", where="at", fix=f"name one of: {', '.join(known)}"
+            )
+        at_list = [crew[0]]
+    obs = [str(o) for o in _as_list(observe)]
+    if not obs:
+        obs = [p for p, k in points if k == "experiment"] or list(known)
+    dirs = _directions(direction) or [DEFAULTS["direction"]]
+    for name, vals in (("at", at_list), ("direction", dirs)):
+        if len(vals) not in (1, nf):
+            raise InputError(
+                f"{len(vals)} values for {nf} forces", where=name, fix="give one, or one per force"
+            )
+    _check_points(at_list, known, "at")
+    _check_points(obs, known, "observe")
+    if len(set(obs)) != len(obs):
+        raise InputError("a point is observed twice", where="observe", fix="name each point once")
+    dists = []
+    for i, f in enumerate(forces):
+        w = "direction" if len(dirs) == 1 else f"direction[{i}]"
+        d = parse_direction(dirs[i if len(dirs) == nf else 0], w)
+        dists.append(Disturbance(f, at_list[i if len(at_list) == nf else 0], d))
+    if not (isinstance(damping, int | float) and 0.0 <= float(damping) < 1.0):
+        raise InputError(f"must be 0 <= zeta < 1, got {damping!r}", where="damping")
+    pm = (
+        DEFAULTS["package_mass_kg"]
+        if package_mass is None
+        else _si(package_mass, "mass", "package_mass", units)
+    )
+    if not pm > 0:
+        raise InputError(f"must be > 0, got {package_mass!r}", where="package_mass")
+    if absorber_mu is not None and not (np.isfinite(absorber_mu) and absorber_mu > 0):
+        raise InputError(f"must be > 0, got {absorber_mu!r}", where="absorber_mu")
+    opts = AnalysisOptions(
+        disturbances=dists,
+        observe=obs,
+        method=method,
+        plane=plane,
+        n=n,
+        n_modes=n_modes,
+        zeta=float(damping),
+        max_freq_hz=_si(max_freq, "frequency", "max_freq", units),
+        duration_s=_si(duration, "time", "duration", units),
+        dt_s=_si(dt, "time", "dt", units),
+        requirement=requirement.name if isinstance(requirement, Requirement) else requirement,
+        package_mass_kg=pm,
+        absorber_mu=absorber_mu,
+        isolation=isolation,
+        gravity_gradient=gravity_gradient,
+    )
+    return run_analysis(
+        mdl,
+        opts,
+        progress=progress,
+        requirement=requirement if isinstance(requirement, Requirement) else None,
+        command=command,
+    )
+
+
+# ------------------------------------------------------------------------------ the job
+
+
+def _check_record(opts: AnalysisOptions) -> None:
+    if not (opts.dt_s > 0 and opts.duration_s > opts.dt_s):
+        raise InputError(
+            f"need 0 < dt < duration, got dt = {opts.dt_s:g} s, duration = {opts.duration_s:g} s",
+            where="dt",
+        )
+    if opts.duration_s / opts.dt_s > MAX_SAMPLES:
+        raise InputError(
+            f"{opts.duration_s / opts.dt_s:.3g} output samples is more than {MAX_SAMPLES:,}",
+            where="duration",
+            fix="shorten the duration or lengthen dt",
+        )
+    if not opts.max_freq_hz > 0:
+        raise InputError(f"must be > 0, got {opts.max_freq_hz:g} Hz", where="max_freq")
+    if not opts.disturbances:
+        raise InputError("no disturbance", where="force", fix="give at least one force")
+    for d in opts.disturbances:
+        end = float(d.force.timepts[-1])
+        if end > opts.duration_s:
+            raise InputError(
+                f"force {d.force.name!r} lasts until {end:g} s, after the {opts.duration_s:g}-s "
+                "record ends: the response to the rest of it is not computed",
+                where="duration",
+                fix=f"use a duration of at least {end:g} s (and time for the response to decay)",
+            )
+
+
+def _structure(model: Any, opts: AnalysisOptions) -> Structure:
+    if isinstance(model, Structure):
+        return model
+    return discretize(
+        model, opts.method, plane=opts.plane, n=opts.n, gravity_gradient=opts.gravity_gradient
+    )
+
+
+def _force_warnings(opts: AnalysisOptions) -> list[str]:
+    out = []
+    for d in opts.disturbances:
+        f = d.force
+        last = float(f.force[-1])
+        peak = float(np.max(np.abs(f.force)))
+        if peak > 0 and abs(last) > 1e-9 * peak:
+            impulse = f.impulse() + last * (opts.duration_s - f.timepts[-1])
+            out.append(
+                f"force {f.name!r} does not end at zero: it holds {last:.4g} N from "
+                f"{f.timepts[-1]:g} s to the end of the record ({opts.duration_s:g} s); its "
+                f"impulse over the record is {impulse:.4g}"
+                " N s, and the station keeps accelerating (a quasi-steady load, not a transient)"
+            )
+    return out
+
+
+def _modal_forces(
+    structure: Structure, modes: Modes, opts: AnalysisOptions
+) -> tuple[list[np.ndarray], list[str]]:
+    """Participation (phi^T b) of each disturbance; refuse a force that does no work."""
+    gammas = []
+    warnings = []
+    for i, d in enumerate(opts.disturbances):
+        tmap = structure.point(d.point).translation
+        u = d.unit_direction
+        b = generalized_force_vector(tmap, u)
+        # the part of the force the model can carry: its projection on the point's motion
+        reach = np.linalg.norm(tmap @ np.linalg.pinv(tmap) @ u) if tmap.size else 0.0
+        if not np.any(b) or reach < 1e-9:
+            where = "direction" if len(opts.disturbances) == 1 else f"direction[{i}]"
+            plane = f" of the planar {structure.plane} model" if structure.plane else ""
+            raise InputError(
+                f"a force along {axis_name(u) or list(np.round(u, 6))} at {d.point!r} does no "
+                f"work on the model{plane}: the response would be zero",
+                where=where,
+                fix="give a direction the model can move in"
+                + (" (in the model's plane), or use the 3-D model" if structure.plane else ""),
+            )
+        if reach < 1 - 1e-9:
+            warnings.append(
+                f"only {100 * reach:.3g}% of the force {d.force.name!r} at {d.point!r} acts on "
+                f"the model{' (its plane is ' + structure.plane + ')' if structure.plane else ''}"
+                "; the rest is dropped"
+            )
+        gammas.append(modes.phi.T @ b)
+    return gammas, warnings
+
+
+def _modal_acceleration(
+    m: Modes, zeta: np.ndarray, opts: AnalysisOptions, gammas: list[np.ndarray], t: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Modal displacement, velocity, acceleration (k, nt) of all disturbances superposed."""
+    eta = np.zeros((m.n_modes, t.size))
+    vel = np.zeros_like(eta)
+    acc = np.zeros_like(eta)
+    for d, g in zip(opts.disturbances, gammas, strict=True):
+        f = d.force
+        r = modal_pwl_response(m.omega, zeta, f.timepts, np.outer(g, f.force), t)
+        eta += r.eta
+        vel += r.eta_dot
+        acc += r.eta_ddot
+    return eta, vel, acc
+
+
+def _contributions(
+    mode_numbers: np.ndarray,
+    m: Modes,
+    tphi: np.ndarray,
+    acc_modal: np.ndarray,
+    t: np.ndarray,
+    a: Assessment,
+) -> ModeContributions:
+    total = tphi @ acc_modal  # (3, nt)
+    mag = np.linalg.norm(total, axis=0)
+    k = int(np.argmax(mag))
+    u = total[:, k] / mag[k] if mag[k] > 0 else np.zeros(3)
+    at_peak = (u @ tphi) * acc_modal[:, k] / G0
+    own = np.max(np.linalg.norm(tphi[:, :, None] * acc_modal[None, :, :], axis=0), axis=1) / G0
+    wb = a.worst_band
+    band_rms_g = None
+    band_hz = None
+    axis = None
+    if wb is not None and np.isfinite(wb.margin):
+        ax = "xyz".index(wb.axis) if wb.axis in "xyz" else 0
+        series = tphi[ax, :, None] * acc_modal  # (k, nt)
+        spec = acceleration_psd(t, series)
+        to = a.third_octave
+        i = int(np.argmin(np.abs(to.center_hz - wb.center_hz)))
+        bands = BandTable(to.center_hz[i : i + 1], to.lower_hz[i : i + 1], to.upper_hz[i : i + 1])
+        band_rms_g = band_rms(spec, bands).rms[:, 0] / G0
+        band_hz = float(wb.center_hz)
+        axis = wb.axis
+    return ModeContributions(
+        mode=mode_numbers,
+        freq_hz=m.freq_hz,
+        at_peak_g=at_peak,
+        own_peak_g=own,
+        worst_band_rms_g=band_rms_g,
+        worst_band_hz=band_hz,
+        worst_axis=axis,
+    )
+
+
+def _intervals(t: np.ndarray, accel: np.ndarray, req: Requirement) -> dict[str, Any]:
+    """Band margins over consecutive intervals of REQUIREMENT_INTERVAL_S (PIMS practice)."""
+    length = REQUIREMENT_INTERVAL_S
+    dt = float(t[1] - t[0])
+    per = int(round(length / dt))
+    count = t.size // per if per >= 8 else 0
+    if count == 0:
+        return {"interval_s": length, "count": 0, "min_margin": None, "worst_start_s": None}
+    worst = np.inf
+    start = None
+    for i in range(count):
+        sl = slice(i * per, (i + 1) * per)
+        sub = assess(t[sl], accel[:, sl], req)
+        mm = float(np.min(sub.third_octave.margin)) if sub.third_octave.margin.size else np.inf
+        if mm < worst:
+            worst, start = mm, float(t[sl][0])
+    return {
+        "interval_s": length,
+        "count": count,
+        "min_margin": worst if np.isfinite(worst) else "inf",
+        "worst_start_s": start,
+    }
+
+
+def _meta(model: Any, command: str | None) -> dict[str, Any]:
+    from microg import __version__
+
+    src = getattr(model, "source", "") or ""
+    sha = None
+    path = None
+    if src:
+        p = Path(src)
+        if p.is_file():
+            path = str(p.resolve())
+            sha = hashlib.sha256(p.read_bytes()).hexdigest()
+        else:
+            path = src
+            try:
+                from importlib import resources
+
+                name = Path(src).name
+                data = resources.files("microg").joinpath("data").joinpath(name).read_bytes()
+                sha = hashlib.sha256(data).hexdigest()
+            except (OSError, FileNotFoundError, ValueError):
+                sha = None
+    return {
+        "microg_version": __version__,
+        "created_utc": _dt.datetime.now(_dt.UTC).strftime("%Y-%m-%dT%H:%M:%SZ"),
+        "command": command,
+        "model_path": path,
+        "model_sha256": sha,
+    }
+
+
+def run_analysis(
+    model: Any,
+    opts: AnalysisOptions,
+    *,
+    progress: Callable[[str], None] | None = None,
+    requirement: Requirement | None = None,
+    command: str | None = None,
+) -> Analysis:
+    """Run the main job on a model with validated options (see :func:`analyze`).
+
+    Parameters
+    ----------
+    model : Station, modal model or Structure
     opts : AnalysisOptions
     progress : callable, optional
         Called with a stage name as each stage starts (for a progress bar).
+    requirement : Requirement, optional
+        Overrides ``opts.requirement`` (a custom requirement object).
+    command : str, optional
+        The command line, for the provenance record.
     """
     step = progress or (lambda _s: None)
-    if not opts.disturbances:
-        raise InputError("no disturbance", where="--force", fix="give at least one --force")
-    if opts.dt <= 0 or opts.duration <= opts.dt:
-        raise InputError("need 0 < dt < duration", where="--dt/--duration")
-    if opts.duration / opts.dt > MAX_SAMPLES:
-        raise InputError(
-            f"{opts.duration / opts.dt:.3g} output samples is more than {MAX_SAMPLES:,}",
-            where="--duration/--dt",
-            fix="shorten --duration or lengthen --dt",
-        )
+    _check_record(opts)
+    req = requirement or _requirement(opts.requirement)
     step("structure")
-    structure = build_structure(station, opts.method, opts.plane, opts.elements_per_beam)
-    points = {name: structure.point(name) for name in opts.observe}
-    forces_at = {d.point: structure.point(d.point) for d in opts.disturbances}
+    structure = _structure(model, opts)
+    for d in opts.disturbances:
+        structure.point(d.point)
+    maps = {name: structure.point(name).translation for name in opts.observe}
     step("modes")
     n_req = None
     if structure.is_sparse:
-        n_req = min(structure.n_dof - 1, 60)
+        n_req = min(structure.n_dof - 1, opts.n_modes or DEFAULT_SPARSE_MODES)
     modes = solve_modes(structure, n_req)
-    used = modes.rigid | (modes.freq_hz <= opts.max_freq_hz)
-    warnings = []
+    warnings: list[str] = []
+    elastic = getattr(modes, "elastic", ~modes.rigid)
+    used = modes.rigid | (np.asarray(elastic) & (modes.freq_hz <= opts.max_freq_hz))
     if structure.is_sparse and not modes.rigid[-1] and modes.freq_hz[-1] <= opts.max_freq_hz:
         warnings.append(
             f"only {modes.n_modes} modes computed; the highest ({modes.freq_hz[-1]:.3g} Hz) is "
-            f"below --max-freq {opts.max_freq_hz:g} Hz"
+            f"below max_freq {opts.max_freq_hz:g} Hz: modes between are missing from the response"
         )
-    m = modes.subset(np.nonzero(used)[0])
+    idx = np.flatnonzero(used)
+    m = modes.subset(idx)
+    nyquist = 0.5 / opts.dt_s
+    f_top = float(np.max(m.freq_hz, initial=0.0))
+    if f_top >= nyquist:
+        raise InputError(
+            f"dt = {opts.dt_s:g} s samples at {1 / opts.dt_s:g} Hz, too coarse for the modes in "
+            f"the response (up to {f_top:.3g} Hz, above the {nyquist:.3g}-Hz Nyquist frequency): "
+            "the spectrum and the band verdict would be aliased",
+            where="dt",
+            fix=f"use dt <= {0.25 / f_top:.3g} s, or max_freq below {nyquist:.3g} Hz",
+        )
+    if f_top > 0.5 * nyquist:
+        warnings.append(
+            f"the highest mode in the response ({f_top:.3g} Hz) is above half the Nyquist "
+            f"frequency ({nyquist:.3g} Hz): fewer than 4 samples per period; bands near Nyquist "
+            "are approximate"
+        )
+    warnings += _force_warnings(opts)
     zeta = np.where(m.rigid, 0.0, opts.zeta)
+    gammas, w = _modal_forces(structure, m, opts)
+    warnings += w
     step("response")
-    timepts = np.arange(0.0, opts.duration + 0.5 * opts.dt, opts.dt)
-    maps = {n: p.translation for n, p in points.items()}
-    responses: dict[str, PointResponse] = {}
-    for d in opts.disturbances:
-        b = generalized_force_vector(forces_at[d.point].translation, d.unit_direction)
-        r = response_at_points(m.omega, zeta, m.phi, maps, d.force, b, timepts)
-        for name, pr in r.items():
-            if name in responses:
-                old = responses[name]
-                responses[name] = PointResponse(
-                    name,
-                    timepts,
-                    old.displacement + pr.displacement,
-                    old.velocity + pr.velocity,
-                    old.acceleration + pr.acceleration,
-                )
-            else:
-                responses[name] = pr
+    t = np.arange(0.0, opts.duration_s + 0.5 * opts.dt_s, opts.dt_s)
+    eta, vel, acc = _modal_acceleration(m, zeta, opts, gammas, t)
     step("assessment")
-    req = iss_requirement() if opts.requirement == "iss" else report_flat_requirement()
-    assessments = {n: assess(timepts, r.acceleration, req) for n, r in responses.items()}
-    step("isolation")
-    advice = {n: _advise(n, a, opts, responses[n], req) for n, a in assessments.items()}
-    fitted = [m.name for m in station.all_masses() if m.fitted]
-    notes = []
-    if fitted:
-        notes.append(
-            f"{len(fitted)} mass items of model {station.name!r} carry fitted values (marked "
-            f"fitted = true in the model file: {', '.join(sorted(set(fitted)))}); for the "
-            "shipped IOC models these were fitted to the seed report's Appendix C because the "
-            "OCR lost them, so local results near them (the keel) inherit that uncertainty"
+    observations: dict[str, Observation] = {}
+    mode_numbers = idx + 1
+    for name, tmap in maps.items():
+        tphi = tmap @ m.phi
+        resp = PointResponse(name, t, tphi @ eta, tphi @ vel, tphi @ acc)
+        a = assess(t, resp.acceleration, req)
+        contrib = _contributions(mode_numbers, m, tphi, acc, t, a)
+        observations[name] = Observation(
+            name=name,
+            response=resp,
+            assessment=a,
+            isolation=IsolationAdvice.not_assessed(name),
+            contributions=contrib,
+            interval=_intervals(t, resp.acceleration, req),
         )
+    step("isolation")
+    if opts.isolation:
+        for name, ob in observations.items():
+            adv = advise_isolation(
+                name,
+                ob.assessment,
+                ob.response,
+                req,
+                package_mass=opts.package_mass_kg,
+                absorber_mu=opts.absorber_mu,
+            )
+            observations[name] = replace(ob, isolation=adv)
+    notes = _notes(model, opts, observations)
+    name = getattr(model, "name", None) or structure.meta.get("model", "model")
     return Analysis(
-        model=station.name,
+        model=str(name),
         options=opts,
         structure=structure,
         modes=modes,
         used=used,
-        responses=responses,
-        assessments=assessments,
-        isolation=advice,
-        timepts=timepts,
+        observations=observations,
+        timepts=t,
+        requirement=req,
         warnings=warnings,
         notes=notes,
+        meta=_meta(model, command),
     )
 
 
-def peak_g(response: PointResponse) -> float:
-    """Peak magnitude of a point's acceleration, g."""
-    return float(np.max(np.linalg.norm(response.acceleration, axis=0)) / G0)
+def _notes(model: Any, opts: AnalysisOptions, obs: Mapping[str, Observation]) -> list[str]:
+    notes = [
+        f"the band verdict is judged on the band RMS over the whole {opts.duration_s:g}-s "
+        f"record: a choice (a transient's band RMS falls as the record grows); the margin over "
+        f"the worst {REQUIREMENT_INTERVAL_S:g}-s interval is given beside it"
+    ]
+    masses = getattr(model, "all_masses", None)
+    fitted = [pm.name for pm in masses() if pm.fitted] if callable(masses) else []
+    if fitted:
+        notes.append(
+            f"{len(fitted)} mass items of model {getattr(model, 'name', '')!r} carry fitted "
+            f"values (marked fitted = true in the model file: {', '.join(sorted(set(fitted)))}); "
+            "for the shipped IOC models these were fitted to the seed report's Appendix C "
+            "because the OCR lost them, so local results near them (the keel) inherit that "
+            "uncertainty"
+        )
+    return notes

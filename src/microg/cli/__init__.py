@@ -97,7 +97,34 @@ def main(argv: list[str] | None = None) -> int:
         return exc.exit_code
     except BrokenPipeError:
         return 1
+    except (MemoryError, RecursionError) as exc:
+        click.echo(
+            f"microg: error: {_command(argv)}: the input is too large for this machine "
+            f"({type(exc).__name__}); reduce the model or the request",
+            err=True,
+        )
+        return 2
+    except KeyboardInterrupt:
+        click.echo("microg: interrupted", err=True)
+        return 130
+    except Exception as exc:  # the funnel: a defect, never a traceback
+        click.echo(
+            f"microg: internal error in {_command(argv)} ({type(exc).__name__}: "
+            f"{_one_line(str(exc))[:300]}); this is a defect of microg, not of your input: "
+            "please report it with the command line",
+            err=True,
+        )
+        return 3
     return 0
+
+
+def _command(argv: list[str] | None) -> str:
+    """The subcommand being run, for error messages."""
+    args = sys.argv[1:] if argv is None else argv
+    for a in args:
+        if not a.startswith("-"):
+            return f"'microg {a}'"
+    return "'microg'"
 
 
 def _entry() -> None:  # pragma: no cover - used by ``python -m microg``

@@ -1,14 +1,79 @@
-"""``microg analyze``: the main job on a station model (default: the shipped IOC model)."""
+"""``microg analyze``: the main job on a model (default: the shipped IOC model).
+
+Parse -> :func:`microg.analyze` -> format.  Option values are handed to the library as the
+user wrote them (a bare number takes the model's unit system there); the library's errors
+name its parameters, which :func:`flag_errors` maps back to the options.
+"""
 
 from __future__ import annotations
 
+import shlex
+import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
+from typing import Any
 
 import click
 
-from microg.cli.params import PositiveFloat, QuantityType
+from microg.analysis import DEFAULTS
 
-__all__ = ["analyze"]
+__all__ = ["analyze", "flag_errors", "write_outputs"]
+
+#: library parameter -> command-line option
+FLAGS = {
+    "force": "--force",
+    "at": "--at",
+    "direction": "--direction",
+    "observe": "--observe",
+    "damping": "--damping",
+    "method": "--method",
+    "plane": "--plane",
+    "n": "--elements",
+    "n_modes": "--n-modes",
+    "max_freq": "--max-freq",
+    "duration": "--duration",
+    "dt": "--dt",
+    "requirement": "--requirement",
+    "package_mass": "--package-mass/--package-weight",
+    "absorber_mu": "--absorber-mu",
+    "out": "--out",
+}
+
+
+@contextmanager
+def flag_errors(flags: dict[str, str]) -> Iterator[None]:
+    """Re-raise library InputErrors with the option's name in place of the parameter's."""
+    from microg.errors import InputError
+
+    try:
+        yield
+    except InputError as exc:
+        where = exc.where
+        if where:
+            head, _, rest = where.partition("[")
+            if head in flags:
+                where = flags[head] + (f" ({head}[{rest}" if rest else "")
+        raise type(exc)(exc.what, where=where, fix=exc.fix) from None
+
+
+def _weight_to_mass(text: str) -> str:
+    """A weight on Earth (a bare number is lbf) as a mass string; a mass passes through."""
+    from microg.errors import InputError
+    from microg.units import G0, parse_quantity
+
+    try:
+        w = parse_quantity(text, "force", where="--package-weight", default_unit="lbf")
+    except InputError:
+        try:
+            return f"{parse_quantity(text, 'mass', where='--package-weight')!r} kg"
+        except InputError:
+            raise InputError(
+                f"{text!r} is neither a weight nor a mass",
+                where="--package-weight",
+                fix="write e.g. '1000 lbf' or '450 kg'",
+            ) from None
+    return f"{w / G0!r} kg"
 
 
 @click.command()
@@ -18,7 +83,8 @@ __all__ = ["analyze"]
     "forces",
     multiple=True,
     help="Disturbance: crew-pushoff, crew-pushoff:f0=40lbf,t1=0.5s, a library activity "
-    "(foot-pushoff-max, hand-pushoff-mean, ...) or a CSV file. Repeatable. [default: crew-pushoff]",
+    "(foot-pushoff-max, hand-pushoff-mean, ...) or a CSV file. Repeatable. "
+    f"[default: {DEFAULTS['force']}]",
 )
 @click.option(
     "--at",
@@ -32,7 +98,7 @@ __all__ = ["analyze"]
     "directions",
     multiple=True,
     help="Force direction: x, y, z, -x, ... or 'dx dy dz' (one for all, or one per --force). "
-    "A CSV force's own direction wins. [default: x]",
+    f"A CSV force's own direction wins. [default: {DEFAULTS['direction']}]",
 )
 @click.option(
     "--observe",
@@ -42,74 +108,77 @@ __all__ = ["analyze"]
 @click.option(
     "--damping",
     "zeta",
-    type=PositiveFloat(0.0, strict=False),
-    default=0.005,
-    show_default=True,
-    help="Modal damping ratio of the elastic modes (0 <= zeta < 1).",
+    type=float,
+    default=None,
+    help=f"Modal damping ratio of the elastic modes, 0 <= zeta < 1. [default: "
+    f"{DEFAULTS['damping']}]",
 )
 @click.option(
     "--method",
     type=click.Choice(["fem", "ritz"]),
-    default="fem",
+    default=DEFAULTS["method"],
     show_default=True,
-    help="3-D frame finite elements, or the report's planar assumed modes.",
+    help="3-D frame finite elements, or assumed modes.",
 )
 @click.option(
     "--plane",
     type=click.Choice(["3d", "xz", "yz"]),
-    default="3d",
+    default=DEFAULTS["plane"],
     show_default=True,
-    help="--method ritz: the three-dimensional assumed-modes model, or the report's planar "
-    "model in the X-Z or Y-Z plane.",
+    help="--method ritz: the 3-D assumed-modes model, or the report's planar model.",
 )
 @click.option(
     "--elements",
     type=click.IntRange(1, 10000),
-    default=10,
-    show_default=True,
-    help="Elements per beam (fem) or assumed functions per beam (ritz).",
+    default=None,
+    help="Elements per beam (fem) or assumed functions per beam (ritz). [default: 10 / 1]",
+)
+@click.option(
+    "--n-modes",
+    type=click.IntRange(1, 2000),
+    default=None,
+    help="Modes solved for frame models (the elastic ones up to --max-freq are used). "
+    "[default: 60]",
 )
 @click.option(
     "--max-freq",
-    type=QuantityType("frequency", "Hz", minimum=0.0, strict=True),
-    default="10 Hz",
-    show_default=True,
-    help="Elastic modes up to this frequency enter the response.",
+    default=None,
+    help=f"Elastic modes up to this frequency enter the response. [default: "
+    f"{DEFAULTS['max_freq_hz']:g} Hz]",
 )
 @click.option(
     "--duration",
-    type=QuantityType("time", "s", minimum=0.0, strict=True),
-    default="200 s",
-    show_default=True,
-    help="Length of the response record.  Band RMS (compliance) is taken over this whole "
-    "interval, so a transient's band RMS falls as the record grows.",
+    default=None,
+    help="Length of the response record; band RMS is taken over it, so a transient's band RMS "
+    f"falls as the record grows. [default: {DEFAULTS['duration_s']:g} s]",
 )
 @click.option(
-    "--dt",
-    type=QuantityType("time", "s", minimum=0.0, strict=True),
-    default="0.01 s",
-    show_default=True,
-    help="Output sample interval.",
+    "--dt", default=None, help=f"Output sample interval. [default: {DEFAULTS['dt_s']:g} s]"
 )
 @click.option(
     "--requirement",
-    type=click.Choice(["iss", "flat"]),
-    default="iss",
+    type=click.Choice(["iss", "ssp41000", "flat"]),
+    default=DEFAULTS["requirement"],
     show_default=True,
-    help="ISS vibratory requirement (1/3-octave), or the report's flat 1e-5 g.",
+    help="ISS vibratory requirement as NASA PIMS codes it, the continuous SSP 41000 curve, or "
+    "the report's flat 1e-5 g.",
+)
+@click.option(
+    "--package-mass",
+    default=None,
+    help="Experiment package mass for the isolation advice (a bare number takes the model's "
+    "unit system). [default: 1000 lb]",
 )
 @click.option(
     "--package-weight",
-    type=QuantityType("force", "lbf", minimum=0.0, strict=True),
-    default="1000 lbf",
-    show_default=True,
-    help="Experiment package weight (on Earth) for the isolation advice.",
+    default=None,
+    help="The package's weight on Earth instead of its mass (a bare number is lbf).",
 )
 @click.option(
     "--absorber-mu",
-    type=PositiveFloat(0.0, strict=True),
+    type=float,
     default=None,
-    help="Add a vibration absorber of this mass ratio to the advised mount.",
+    help="Add a vibration absorber of this mass ratio to the report-rule mount.",
 )
 @click.option(
     "--out",
@@ -117,7 +186,7 @@ __all__ = ["analyze"]
     type=click.Path(file_okay=False, path_type=Path),
     default=Path("microg-analysis"),
     show_default=True,
-    help="Directory for report.html, figures and results.json.",
+    help="Directory for report.html, figures and results.json (replaced as a whole).",
 )
 @click.option("--json", "as_json", is_flag=True, help="Also print results.json to stdout.")
 @click.option("--no-progress", is_flag=True, help="Hide the progress bar.")
@@ -127,15 +196,17 @@ def analyze(
     at_points: tuple[str, ...],
     directions: tuple[str, ...],
     observe: tuple[str, ...],
-    zeta: float,
+    zeta: float | None,
     method: str,
     plane: str,
-    elements: int,
-    max_freq: float,
-    duration: float,
-    dt: float,
+    elements: int | None,
+    n_modes: int | None,
+    max_freq: str | None,
+    duration: str | None,
+    dt: str | None,
     requirement: str,
-    package_weight: float,
+    package_mass: str | None,
+    package_weight: str | None,
     absorber_mu: float | None,
     out_dir: Path,
     as_json: bool,
@@ -149,59 +220,31 @@ def analyze(
     """
     from tqdm import tqdm
 
-    from microg._vectors import parse_direction
-    from microg.analysis import AnalysisOptions, Disturbance, run_analysis
-    from microg.dynamics.forces import parse_force_spec
+    import microg
     from microg.errors import InputError
-    from microg.models.toml import load_station
-    from microg.units import G0
 
-    if zeta >= 1.0:
-        raise click.BadParameter(f"must be < 1, got {zeta:g}", param_hint="--damping")
-    station = load_station(model)
-    forces = forces or ("crew-pushoff",)
-    names = [p.name for p in station.points]
-    if not at_points:
-        crew = [p.name for p in station.points if p.kind == "crew"]
-        if not crew:
-            raise InputError(
-                "the model has no crew point", where="--at", fix=f"name one of: {', '.join(names)}"
-            )
-        at_points = (crew[0],)
-    if not observe:
-        observe = tuple(p.name for p in station.points if p.kind == "experiment") or tuple(names)
-    directions = directions or ("x",)
-    n = len(forces)
-    for opt, vals in (("--at", at_points), ("--direction", directions)):
-        if len(vals) not in (1, n):
-            raise InputError(
-                f"{len(vals)} values for {n} --force", where=opt, fix="give one, or one per --force"
-            )
-    for opt, pts in (("--at", at_points), ("--observe", observe)):
-        for p in pts:
-            if p not in names:
-                raise InputError(
-                    f"unknown point {p!r}", where=opt, fix=f"known points: {', '.join(names)}"
-                )
-    dists = []
-    for i, spec in enumerate(forces):
-        f = parse_force_spec(spec)
-        d = parse_direction(directions[i if len(directions) == n else 0], "--direction")
-        dists.append(Disturbance(f, at_points[i if len(at_points) == n else 0], d))
-    opts = AnalysisOptions(
-        disturbances=dists,
-        observe=observe,
-        method=method,
-        plane=plane,
-        elements_per_beam=elements,
-        zeta=zeta,
-        max_freq_hz=max_freq,
-        duration=duration,
-        dt=dt,
-        requirement=requirement,
-        package_mass=package_weight / G0,
-        absorber_mu=absorber_mu,
-    )
+    _check_out(out_dir)
+    if package_mass is not None and package_weight is not None:
+        raise InputError(
+            "give --package-mass or --package-weight, not both", where="--package-mass"
+        )
+    kwargs: dict[str, Any] = {}
+    for key, value in (
+        ("damping", zeta),
+        ("max_freq", max_freq),
+        ("duration", duration),
+        ("dt", dt),
+        ("n", elements),
+        ("n_modes", n_modes),
+        ("absorber_mu", absorber_mu),
+    ):
+        if value is not None:
+            kwargs[key] = value
+    with flag_errors({"package_mass": "--package-weight"}):
+        if package_weight is not None:
+            kwargs["package_mass"] = _weight_to_mass(package_weight)
+    if package_mass is not None:
+        kwargs["package_mass"] = package_mass
     stages = ["structure", "modes", "response", "assessment", "isolation", "report"]
     bar = tqdm(total=len(stages), desc="microg analyze", disable=no_progress or None, leave=False)
 
@@ -210,9 +253,23 @@ def analyze(
         if stage != "structure":
             bar.update(1)
 
-    result = run_analysis(station, opts, progress=progress)
-    progress("report")
-    path = write_outputs(result, out_dir)
+    command = "microg " + " ".join(shlex.quote(a) for a in sys.argv[1:])
+    with flag_errors(FLAGS):
+        result = microg.analyze(
+            model,
+            force=list(forces) or None,
+            at=list(at_points) or None,
+            direction=list(directions) or None,
+            observe=list(observe) or None,
+            method=method,
+            plane=plane,
+            requirement=requirement,
+            progress=progress,
+            command=command,
+            **kwargs,
+        )
+        progress("report")
+        path = write_outputs(result, out_dir)
     bar.update(1)
     bar.close()
     if as_json:
@@ -220,11 +277,23 @@ def analyze(
 
         click.echo(dumps(result.to_dict()))
     else:
-        _summary(result, path)
+        summary(result, path)
 
 
-def write_outputs(result, out_dir: Path) -> Path:
-    """Render figures, HTML and JSON, and write them into ``out_dir`` atomically."""
+def _check_out(out_dir: Path) -> None:
+    from microg.errors import InputError
+
+    if str(out_dir).strip() == "":
+        raise InputError("an empty directory name", where="--out", fix="name a directory")
+    try:
+        from microg._io import check_writable
+    except ImportError:
+        return
+    check_writable(out_dir, where="--out")
+
+
+def write_outputs(result: Any, out_dir: Path) -> Path:
+    """Render figures, HTML and JSON, and write them into ``out_dir`` as one run."""
     from microg._io import dumps, write_output_files
     from microg.report.analysis import figures, render_analysis
 
@@ -235,31 +304,27 @@ def write_outputs(result, out_dir: Path) -> Path:
     return write_output_files(out_dir, files, where="--out")
 
 
-def _summary(result, path: Path) -> None:
+def summary(result: Any, path: Path) -> None:
+    """The console summary: modes, each point's verdicts, isolation, warnings."""
+    from microg.analysis import REPORT_LIMIT_G
+
     m = result.modes
-    el = ~m.rigid & result.used
+    el = (m.omega > 0) & result.used
     click.echo(
         f"{result.model}: {m.n_rigid} rigid-body modes, {int(el.sum())} elastic modes up to "
         f"{result.options.max_freq_hz:g} Hz (first {m.freq_hz[el][0]:.4g} Hz)"
         if el.any()
         else f"{result.model}: {m.n_rigid} rigid-body modes"
     )
-    for name, a in result.assessments.items():
+    for name, ob in result.observations.items():
+        a = ob.assessment
         verdict = "complies" if a.complies else "DOES NOT COMPLY"
-        flat = "within" if a.peak_accel_g <= 1e-5 else "above"
+        flat = "within" if a.peak_accel_g <= REPORT_LIMIT_G else "ABOVE"
         click.echo(
-            f"  {name}: peak {a.peak_accel_g:.3g} g ({flat} the report's 1e-5 g), "
+            f"  {name}: peak {a.peak_accel_g:.3g} g ({flat} the report's {REPORT_LIMIT_G:g} g), "
             f"RMS {a.rms_accel_g:.3g} g, {verdict} with {a.requirement}"
         )
-        adv = result.isolation[name]
-        click.echo(f"    isolation: {adv.note}")
-        if adv.design is not None:
-            d = adv.design
-            click.echo(
-                f"    report's rule (Sec. 4.2): k1 <= {d.k1:.4g} N/m "
-                f"({d.k1_lbf_per_in:.4g} lbf/in), natural frequency {d.freq_hz_n:.3g} Hz, "
-                f"sag under 1 g {d.sag_1g:.3g} m"
-            )
+        click.echo(f"    isolation: {ob.isolation.note}")
     for w in result.warnings:
         click.echo(f"  warning: {w}")
     click.echo(f"report written to {path / 'report.html'}")

@@ -1,151 +1,180 @@
 """``microg modes``: natural frequencies, rigid-body modes, modal and effective masses.
 
-The command computes nothing itself: it loads the model, builds the assumed-modes
-(:func:`~microg.structure.ritz.build_ritz`) or frame finite-element
-(:func:`~microg.structure.fem.build_fem`)
-structure, solves it with :func:`microg.dynamics.modes.solve_modes` and prints the result.
+Parse -> :func:`microg.load_model` and :func:`microg.solve_modes` -> format.  Frame models
+asked for a plane report only the modes with more than half their kinetic energy in it
+(:func:`microg.dynamics.planar.in_plane_modes`).
 """
 
 from __future__ import annotations
 
+from pathlib import Path
+from typing import Any
+
 import click
-import numpy as np
 
-from microg._io import dumps
-from microg.errors import InputError
+__all__ = ["modes"]
 
-__all__ = ["modes", "build_structure", "DEFAULT_FEM_MODES"]
-
-#: modes reported by --method fem when --n-modes is not given
-DEFAULT_FEM_MODES = 20
-
-
-def build_structure(
-    model: str,
-    method: str,
-    plane: str | None,
-    functions: int | None,
-    elements: int | None,
-):
-    """Load ``model`` and discretise it; option conflicts are InputErrors (exit 2)."""
-    from microg.models.toml import load_station
-
-    if method == "ritz" and elements is not None:
-        raise InputError("applies to --method fem only", where="--elements")
-    if method == "fem" and functions is not None:
-        raise InputError("applies to --method ritz only", where="--functions")
-    station = load_station(model)
-    if method == "ritz":
-        from microg.structure.ritz import build_ritz
-
-        ritz_plane = None if plane == "3d" else (plane or "xz")
-        return station, build_ritz(station, ritz_plane, functions or 1)
-    from microg.structure.fem import build_fem
-
-    return station, build_fem(station, elements_per_beam=elements)
+FLAGS = {
+    "method": "--method",
+    "plane": "--plane",
+    "n": "--elements/--functions",
+    "n_modes": "--n-modes",
+    "units": "--units",
+    "wtmass": "--wtmass",
+    "points": "--points",
+}
 
 
-def solve_for_cli(structure, method: str, plane: str | None, n_modes: int | None):
-    """Modes of ``structure``; for frame models with ``plane``, only the in-plane modes.
+def _default_modes() -> int:
+    from microg.dynamics import modes as mod
 
-    A frame mode is in ``plane`` when more than half of its kinetic energy is in-plane
-    motion (:func:`microg.location.amap.in_plane_fraction`).  ``n_modes`` counts reported modes.
-    """
-    from microg.dynamics.modes import solve_modes
-    from microg.location.amap import in_plane_fraction
-
-    if method == "ritz":
-        return solve_modes(structure, n_modes)
-    want = n_modes or DEFAULT_FEM_MODES
-    if plane is None:
-        return solve_modes(structure, want)
-    ask = min(max(3 * want, want + 6), structure.n_dof)
-    m = solve_modes(structure, ask)
-    keep = np.flatnonzero(in_plane_fraction(structure, m, plane) > 0.5)[:want]
-    return m.subset(keep)
+    return int(getattr(mod, "DEFAULT_N_MODES", 20))
 
 
-def _effective_percent(structure, m) -> dict[str, np.ndarray]:
-    """Effective mass per direction as a percentage of the station's r^T M r."""
-    out = {}
-    for d, r in structure.rigid_body.items():
-        r = np.asarray(r, float)
-        total = float(r @ (structure.mass @ r))
-        if d in m.effective_mass and total > 0:
-            out[d] = 100.0 * np.asarray(m.effective_mass[d]) / total
-    return out
+def _effective_percent(m: Any) -> dict[str, Any]:
+    frac = getattr(m, "effective_mass_fraction", None)
+    if frac is None:
+        import numpy as np
+
+        s = m.structure
+        out = {}
+        for d, r in s.rigid_body.items():
+            r = np.asarray(r, float)
+            total = float(r @ (s.mass @ r))
+            if d in m.effective_mass and total > 0:
+                out[d] = 100.0 * np.asarray(m.effective_mass[d]) / total
+        return out
+    return {d: 100.0 * v for d, v in (frac() if callable(frac) else frac).items()}
 
 
 @click.command()
 @click.argument("model")
 @click.option(
     "--method",
-    type=click.Choice(["ritz", "fem"]),
-    default="ritz",
+    type=click.Choice(["fem", "ritz"]),
+    default="fem",
     show_default=True,
-    help="Assumed modes (the report's method) or 3-D frame finite elements.",
+    help="3-D frame finite elements, or assumed modes (the report's method). Imported modal "
+    "models ignore it.",
 )
 @click.option(
     "--plane",
     type=click.Choice(["xz", "yz", "3d"]),
-    default=None,
-    help="Ritz: the report's planar model in this plane (default xz), or 3d for the "
-    "three-dimensional assumed-modes model.  FE: report only the modes with more than half "
-    "of their kinetic energy in this plane.",
+    default="3d",
+    show_default=True,
+    help="Ritz: the report's planar model in this plane, or the 3-D assumed-modes model. "
+    "FE: report only the modes with more than half their kinetic energy in this plane.",
 )
 @click.option(
     "--functions",
     type=click.IntRange(1, 16),
     default=None,
-    help="Ritz: admissible functions per beam (default 1, the report's model).",
+    help="Ritz: admissible functions per beam and deformation kind (default 1).",
 )
 @click.option(
     "--elements",
-    type=click.IntRange(1, 2000),
+    type=click.IntRange(1, 10000),
     default=None,
     help="FE: minimum elements per beam (default 10; more where masses and joints cut it).",
 )
 @click.option(
     "--n-modes",
     "n_modes",
-    type=click.IntRange(min=1),
+    type=click.IntRange(1, 2000),
     default=None,
-    help=f"Number of lowest modes (Ritz default: all; FE default: {DEFAULT_FEM_MODES}).",
+    help="Number of lowest modes, at least the rigid-body ones (Ritz default: all; FE "
+    "default: 20).",
+)
+@click.option(
+    "--gravity-gradient/--free-free",
+    default=False,
+    show_default=True,
+    help="Restrain the rigid rotations by gravity gradient (libration), as the report's "
+    "Appendix B does; the default is the free-free structure.",
+)
+@click.option("--units", default=None, help="Units of a NASTRAN/UFF file: 'LENGTH,FORCE,TIME'.")
+@click.option("--wtmass", type=float, default=None, help="NASTRAN PARAM WTMASS of the run.")
+@click.option(
+    "--points",
+    type=click.Path(dir_okay=False, path_type=Path),
+    default=None,
+    help='TOML file naming grids of an imported model (lab = "grid:2001").',
+)
+@click.option(
+    "--uff",
+    "uff_out",
+    type=click.Path(dir_okay=False, path_type=Path),
+    default=None,
+    help="Also write the modes as UFF datasets 15+55 (+164 units) to this file.",
 )
 @click.option("--json", "as_json", is_flag=True, help="Print the modes as JSON.")
 def modes(
     model: str,
     method: str,
-    plane: str | None,
+    plane: str,
     functions: int | None,
     elements: int | None,
     n_modes: int | None,
+    gravity_gradient: bool,
+    units: str | None,
+    wtmass: float | None,
+    points: Path | None,
+    uff_out: Path | None,
     as_json: bool,
 ) -> None:
-    """Natural frequencies and mode properties of a station MODEL (file or shipped name).
+    """Natural frequencies and mode properties of MODEL (a model file or a shipped name).
 
-    Rigid-body modes are exact (omega = 0).  Modal mass is the generalized mass of each shape
-    scaled to a largest point translation of 1 m; effective mass is (phi^T M r)^2 per
-    rigid-body direction r (zero for the elastic modes of a free-free structure, which are
-    M-orthogonal to the rigid motions; non-zero where gravity gradient restrains a rotation).
+    Rigid-body modes are exact (omega = 0).  Modal mass and effective mass as defined in
+    microg.dynamics.modes.Modes; effective mass is (phi^T M r)^2 per rigid-body direction r
+    (zero for the elastic modes of a free-free structure, which are M-orthogonal to the rigid
+    motions; non-zero where gravity gradient restrains a rotation).
     """
-    _, structure = build_structure(model, method, plane, functions, elements)
-    if plane == "3d":
-        plane = None
-    m = solve_for_cli(structure, method, plane, n_modes)
-    plane_out = structure.plane if method == "ritz" else plane
+    import microg
+    from microg._io import dumps
+    from microg.cli.analyze import flag_errors
+    from microg.errors import InputError
+    from microg.structure.discretize import discretize
+
+    if method == "ritz" and elements is not None:
+        raise InputError("applies to --method fem only", where="--elements")
+    if method == "fem" and functions is not None:
+        raise InputError("applies to --method ritz only", where="--functions")
+    options = {k: v for k, v in (("units", units), ("wtmass", wtmass), ("points", points)) if v}
+    with flag_errors(FLAGS):
+        mdl = microg.load_model(model, **options)
+        fem_plane = method == "fem" and plane != "3d"
+        structure = discretize(
+            mdl,
+            method,
+            plane="3d" if fem_plane else plane,
+            n=elements if method == "fem" else functions,
+            gravity_gradient=gravity_gradient,
+        )
+        want = n_modes
+        if structure.is_sparse and want is None:
+            want = _default_modes()
+        if fem_plane:
+            from microg.dynamics.planar import in_plane_modes
+
+            ask = min(max(3 * (want or 20), (want or 20) + 6), structure.n_dof)
+            m = in_plane_modes(structure, microg.solve_modes(structure, n_modes=ask), plane, want)
+        else:
+            m = microg.solve_modes(structure, n_modes=want)
+        if uff_out is not None:
+            from microg.models.uff import write_uff_modes
+
+            write_uff_modes(m, uff_out)
+    plane_out = structure.plane if structure.plane else (plane if fem_plane else None)
+    name = getattr(mdl, "name", None) or structure.meta.get("model", model)
     if as_json:
         data = m.to_dict()
-        out = {"method": data["method"], "model": structure.meta.get("model", model)}
-        out["plane"] = plane_out
-        out["modes"] = data["modes"]
+        out = {"model": name, "plane": plane_out, **data}
         click.echo(dumps(out))
         return
-    pct = _effective_percent(structure, m)
+    pct = _effective_percent(m)
     dirs = list(pct)
-    label = structure.meta.get("model", model)
     where = f", plane {plane_out}" if plane_out else ""
-    click.echo(f"{label}: {m.n_modes} modes ({method}{where}, {structure.n_dof} coordinates)")
+    click.echo(f"{name}: {m.n_modes} modes ({m.method}{where}, {structure.n_dof} coordinates)")
     head = f"{'#':>3} {'omega (rad/s)':>14} {'f (Hz)':>11} {'rigid':>5} {'modal mass (kg)':>16}"
     head += "".join(f" {'eff ' + d + ' %':>9}" for d in dirs)
     click.echo(head)
@@ -154,5 +183,42 @@ def modes(
             f"{j + 1:>3} {m.omega[j]:>14.6g} {m.freq_hz[j]:>11.5g} "
             f"{'yes' if m.rigid[j] else 'no':>5} {m.modal_mass[j]:>16.6g}"
         )
-        row += "".join(f" {pct[d][j]:>9.3g}" for d in dirs)
+        row += "".join(f" {_pct(pct[d][j]):>9}" for d in dirs)
         click.echo(row)
+
+
+def _pct(v: float) -> str:
+    return "0" if v == 0 else f"{v:.3g}"
+
+
+# ---- transitional: cli/locate.py still imports these two; removed when it moves to the API
+def build_structure(
+    model: str, method: str, plane: str | None, functions: int | None, elements: int | None
+) -> tuple[Any, Any]:
+    """Load and discretise ``model`` (transitional helper for ``microg locate``)."""
+    import microg
+    from microg.errors import InputError
+    from microg.structure.discretize import discretize
+
+    if method == "ritz" and elements is not None:
+        raise InputError("applies to --method fem only", where="--elements")
+    if method == "fem" and functions is not None:
+        raise InputError("applies to --method ritz only", where="--functions")
+    station = microg.load_station(model)
+    if method == "ritz":
+        return station, discretize(
+            station, "ritz", plane=plane or "xz", n=functions, gravity_gradient=True
+        )
+    return station, discretize(station, "fem", n=elements)
+
+
+def solve_for_cli(structure: Any, method: str, plane: str | None, n_modes: int | None) -> Any:
+    """Modes for ``microg locate`` (transitional helper)."""
+    import microg
+    from microg.dynamics.planar import in_plane_modes
+
+    if method == "ritz" or plane is None:
+        return microg.solve_modes(structure, n_modes=n_modes or (None if method == "ritz" else 20))
+    want = n_modes or 20
+    ask = min(max(3 * want, want + 6), structure.n_dof)
+    return in_plane_modes(structure, microg.solve_modes(structure, n_modes=ask), plane, want)

@@ -5,15 +5,11 @@ from __future__ import annotations
 import io
 from pathlib import Path
 
-import matplotlib
+import numpy as np
+from matplotlib.figure import Figure
 
-matplotlib.use("Agg")
-
-import numpy as np  # noqa: E402
-from matplotlib.figure import Figure  # noqa: E402
-
-from microg.isolation.design import FIGURE8_CURVES  # noqa: E402
-from microg.isolation.transmissibility import (  # noqa: E402
+from microg.isolation.design import FIGURE8_CURVES
+from microg.isolation.transmissibility import (
     accel_magnification,
     accel_magnification_no_absorber,
 )

@@ -2,23 +2,19 @@
 
 from __future__ import annotations
 
-import base64
-import io
+from typing import Any
 
-import matplotlib
+from matplotlib.figure import Figure
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-from matplotlib.figure import Figure  # noqa: E402
+from microg.seed.reproduce import CurveSet
+from microg.units import G0
 
-from microg.seed.reproduce import CurveSet  # noqa: E402
-from microg.units import G0  # noqa: E402
-
-__all__ = ["figure3", "figure4", "point_response_figure", "png_bytes", "png_data_uri"]
+__all__ = ["figure3", "figure4", "point_response_figure"]
 
 
 def _curves(curves: CurveSet, which: str, title: str, ylabel: str) -> Figure:
-    fig, ax = plt.subplots(figsize=(7.5, 4.2), layout="constrained")
+    fig = Figure(figsize=(7.5, 4.2), layout="constrained")
+    ax = fig.subplots()
     data = curves.u if which == "u" else curves.a
     for w, y in zip(curves.omega, data, strict=True):
         ax.plot(curves.timepts, y, lw=1.3, label=f"w = {w:g} rad/s")
@@ -41,9 +37,10 @@ def figure4(curves: CurveSet) -> Figure:
     return _curves(curves, "a", "Figure 4 - acceleration functions A(t), Eq. 2.19", "A(t)")
 
 
-def point_response_figure(responses: dict, z_e_ft: float, z_a_ft: float) -> Figure:
+def point_response_figure(responses: dict[str, Any], z_e_ft: float, z_a_ft: float) -> Figure:
     """Acceleration at z_e from the crew force at z_a per case (Eq. 2.20b), in micro-g."""
-    fig, axes = plt.subplots(2, 2, figsize=(9.5, 6.0), layout="constrained", sharex=True)
+    fig = Figure(figsize=(9.5, 6.0), layout="constrained")
+    axes = fig.subplots(2, 2, sharex=True)
     for ax, (case, r) in zip(axes.ravel(), responses.items(), strict=False):
         for j, a in enumerate(r.accel_modes, 1):
             ax.plot(r.timepts, a / G0 * 1e6, lw=0.9, label=f"mode {j}")
@@ -58,16 +55,3 @@ def point_response_figure(responses: dict, z_e_ft: float, z_a_ft: float) -> Figu
         f"Acceleration at z_e = {z_e_ft:.4g} ft, crew force at z_a = {z_a_ft:.4g} ft (Eq. 2.20b)"
     )
     return fig
-
-
-def png_bytes(fig: Figure, dpi: int = 110) -> bytes:
-    """Render ``fig`` to PNG bytes and close it."""
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=dpi)
-    plt.close(fig)
-    return buf.getvalue()
-
-
-def png_data_uri(png: bytes) -> str:
-    """A ``data:image/png;base64,...`` URI for embedding in HTML."""
-    return "data:image/png;base64," + base64.b64encode(png).decode("ascii")

@@ -1,0 +1,332 @@
+"""Isolation advice for a point that does not comply: the policy, as structured data.
+
+The policy, in order:
+
+1. A point that complies needs nothing (``status = "not-needed"``).
+2. A point that fails only a peak limit (no band exceeds) cannot be helped by a passive mount
+   without the transient's spectrum (``"peak-only"``).
+3. Otherwise the exceeding bands give the attenuation needed, band by band (1 / margin).  The
+   report's rule (Section 4.2, :func:`~microg.isolation.design.design_mount`) sizes a mount for
+   ``M_a <= target`` over the exceeding band; its undamped resonance is excited by a transient
+   below that band, so spring-damper mounts are also screened on the whole spectrum
+   (:func:`~microg.isolation.mount.search_mount`).  The screened choice (or, when none
+   complies, the report-rule design) is verified with the exact time-domain response of the
+   package (:func:`~microg.isolation.timedomain.package_response`).
+4. A mount is **recommended** only when that time-domain check complies and the record can
+   see the mount's resonance (its natural frequency lies in a band the record resolves;
+   otherwise the advice names the record length needed) (``"passive-mount"``).  Otherwise no passive mount in the screen complies
+   (``"no-passive-mount"``): the advice says so, gives the attenuation needed per band, and
+   that active isolation is needed.  A design that fails its own check is never recommended.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from microg.errors import InputError
+from microg.units import IN, LBF
+
+if TYPE_CHECKING:
+    from microg.dynamics.response import PointResponse
+    from microg.environment.metrics import Assessment
+    from microg.environment.requirements import Requirement
+    from microg.isolation.design import MountDesign
+    from microg.isolation.mount import MountChoice
+
+__all__ = ["IsolationAdvice", "advise_isolation", "STATUSES"]
+
+#: the advice's possible outcomes
+STATUSES = (
+    "not-assessed",
+    "not-needed",
+    "peak-only",
+    "passive-mount",
+    "no-passive-mount",
+    "no-design",
+)
+
+
+@dataclass(frozen=True)
+class IsolationAdvice:
+    """Isolation advice for one observed point.
+
+    Attributes
+    ----------
+    point : str
+    status : str
+        One of :data:`STATUSES`.
+    attenuation_needed : dict of float to float
+        Exceeding band centre (Hz) -> factor by which that band must be attenuated
+        (1 / margin, > 1).
+    band_hz : tuple of float or None
+        Lowest and highest edges of the exceeding bands, Hz.
+    target_ma : float or None
+        Largest acceleration magnification that brings every exceeding band to its limit.
+    design : MountDesign or None
+        The report's rule (Sec. 4.2) over the exceeding band.
+    mount : MountChoice or None
+        The whole-spectrum screen of spring-damper mounts.
+    verified : str or None
+        Which mount the time-domain check ran on: ``"screened"`` or ``"report-rule"``.
+    isolated : Assessment or None
+        The package's acceleration on the verified mount, against the same requirement.
+    package_accel : ndarray (3, nt) or None
+        What the isolated package feels, m/s^2.
+    peak_stroke_m : float or None
+        Largest package motion relative to the mount (rattle space), m.
+    verifiable : bool
+        The verified mount's natural frequency lies in the bands the record resolves, so the
+        time-domain check can see its resonance.
+    recommended : bool
+        True only when the verified mount complies in the time domain and is verifiable.
+    note : str
+        One-paragraph summary of the above.
+    """
+
+    point: str
+    status: str
+    attenuation_needed: dict[float, float] = field(default_factory=dict)
+    band_hz: tuple[float, float] | None = None
+    target_ma: float | None = None
+    design: MountDesign | None = None
+    mount: MountChoice | None = None
+    verified: str | None = None
+    isolated: Assessment | None = None
+    package_accel: np.ndarray | None = None
+    peak_stroke_m: float | None = None
+    verifiable: bool = False
+    recommended: bool = False
+    note: str = ""
+
+    @property
+    def needed(self) -> bool:
+        """True when the point does not comply."""
+        return self.status not in ("not-needed", "not-assessed")
+
+    @classmethod
+    def not_assessed(cls, point: str) -> IsolationAdvice:
+        """Advice placeholder when isolation is not asked for."""
+        return cls(point, "not-assessed", note="isolation not assessed")
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready advice (keys documented in docs/assessment.md)."""
+        out: dict[str, Any] = {
+            "status": self.status,
+            "needed": self.needed,
+            "recommended": self.recommended,
+            "verifiable_by_record": self.verifiable,
+            "note": self.note,
+            "band_hz": self.band_hz,
+            "target_Ma": self.target_ma,
+            "attenuation_needed": [
+                {"center_hz": c, "factor": f} for c, f in sorted(self.attenuation_needed.items())
+            ],
+            "design": None,
+            "recommended_mount": None,
+            "screened_mount": None,
+            "isolated": None,
+        }
+        d = self.design
+        if d is not None:
+            out["design"] = {
+                "rule": "report Section 4.2: M_a <= target over the exceeding band",
+                "k1_N_per_m": d.k1,
+                "k1_lbf_per_in": d.k1_lbf_per_in,
+                "omega_n": d.omega_n,
+                "freq_hz_n": d.freq_hz_n,
+                "achieved_Ma": d.achieved_Ma,
+                "sag_1g_m": d.sag_1g,
+                "mu": d.mu,
+                "absorber_k": d.k,
+            }
+        mc = self.mount
+        if mc is not None:
+            screened = {
+                "found": bool(mc.found),
+                "k1_N_per_m": mc.k1,
+                "k1_lbf_per_in": mc.k1 * IN / LBF,
+                "zeta1": mc.zeta1,
+                "c1_N_s_per_m": mc.c1,
+                "freq_hz_n": mc.freq_hz_n,
+                "screen_min_margin": mc.min_margin,
+                "screened": mc.screened,
+            }
+            out["screened_mount"] = screened
+            if self.recommended and self.verified == "screened":
+                out["recommended_mount"] = screened
+        if self.recommended and self.verified == "report-rule" and out["design"] is not None:
+            out["recommended_mount"] = {"found": True, **out["design"]}
+        if self.isolated is not None:
+            iso = self.isolated
+            wb = iso.worst_band
+            out["isolated"] = {
+                "verified_mount": self.verified,
+                "peak_accel_g": iso.peak_accel_g,
+                "rms_accel_g": iso.rms_accel_g,
+                "complies": bool(iso.complies),
+                "peak_stroke_m": self.peak_stroke_m,
+                "worst_band": None
+                if wb is None
+                else {"center_hz": wb.center_hz, "margin": _finite(wb.margin)},
+            }
+        return out
+
+
+def _finite(x: float) -> float | str:
+    return float(x) if np.isfinite(x) else "inf"
+
+
+def advise_isolation(
+    point: str,
+    assessment: Assessment,
+    response: PointResponse,
+    requirement: Requirement,
+    *,
+    package_mass: float,
+    absorber_mu: float | None = None,
+) -> IsolationAdvice:
+    """Isolation advice for one point (the policy of the module docstring).
+
+    Parameters
+    ----------
+    point : str
+        Point name.
+    assessment : Assessment
+        The point's assessment against ``requirement``.
+    response : PointResponse
+        The point's motion (the mount's base motion), SI.
+    requirement : Requirement
+    package_mass : float
+        Experiment package mass, kg.
+    absorber_mu : float, optional
+        Absorber mass ratio for the report-rule design.
+    """
+    from microg.environment.metrics import assess
+    from microg.isolation.design import design_mount
+    from microg.isolation.mount import search_mount
+    from microg.isolation.timedomain import IsolatorModel, package_response
+
+    if assessment.complies:
+        return IsolationAdvice(point, "not-needed", note="complies without isolation")
+    to = assessment.third_octave
+    margin = to.margin.min(axis=0)
+    resolved = np.asarray(getattr(to, "resolved", np.ones(margin.shape, bool)), bool)
+    bad = np.isfinite(margin) & (margin < 1.0) & resolved
+    if not np.any(bad):
+        return IsolationAdvice(
+            point,
+            "peak-only",
+            note="exceeds the peak limit only: a passive mount cannot help a transient's peak "
+            "without knowing its spectrum",
+        )
+    need = {float(c): float(1.0 / mm) for c, mm in zip(to.center_hz[bad], margin[bad], strict=True)}
+    lo = float(to.lower_hz[bad].min())
+    hi = float(to.upper_hz[bad].max())
+    target = float(max(margin[bad].min(), 1e-6))
+    worst_c = max(need, key=lambda c: need[c])
+    base = (
+        f"bands {lo:.3g}-{hi:.3g} Hz exceed the requirement; the worst ({worst_c:.3g} Hz) must "
+        f"be attenuated {need[worst_c]:.3g}x (M_a <= {target:.3g})"
+    )
+    try:
+        design = design_mount(
+            package_mass, (2 * np.pi * lo, 2 * np.pi * hi), min(target, 1.0), mu=absorber_mu
+        )
+    except InputError as exc:
+        return IsolationAdvice(
+            point,
+            "no-design",
+            attenuation_needed=need,
+            band_hz=(lo, hi),
+            target_ma=target,
+            note=f"{base}; the report's rule gives no design ({exc}); active isolation is needed",
+        )
+    # a mount resonating below the record's resolved bands cannot be verified by this record:
+    # screen only mounts whose natural frequency the verdict can see
+    f_floor = float(np.min(to.lower_hz[resolved])) if resolved.any() else float(lo)
+    k_floor = package_mass * (2 * np.pi * f_floor) ** 2
+    k_max = 10.0 * design.k1
+    decades = float(np.clip(np.log10(k_max / k_floor), 0.5, 4.0)) if k_max > k_floor else 0.5
+    choice = search_mount(
+        assessment.spectrum, requirement, package_mass, k_max, decades=decades
+    )
+    if choice.found:
+        mount = IsolatorModel(m1=package_mass, k1=choice.k1, c1=choice.c1)
+        verified = "screened"
+    else:
+        mount = IsolatorModel(
+            m1=package_mass,
+            k1=design.k1,
+            m2=design.m2 or 0.0,
+            k2=design.k2 or 0.0,
+            c=design.c or 0.0,
+        )
+        verified = "report-rule"
+    runs = [package_response(mount, response.timepts, row) for row in response.acceleration]
+    pkg = np.array([r.package_accel for r in runs])
+    isolated = assess(response.timepts, pkg, requirement)
+    stroke = float(max(r.peak_stroke for r in runs))
+    f_n = choice.freq_hz_n if verified == "screened" else design.freq_hz_n
+    visible = f_n >= f_floor
+    ok = bool(isolated.complies) and visible
+    rule = (
+        f"the report's rule gives k1 = {design.k1:.4g} N/m ({design.k1_lbf_per_in:.4g} lbf/in, "
+        f"f_n = {design.freq_hz_n:.3g} Hz)"
+    )
+    check = (
+        f"verified in the time domain: the package {'complies' if ok else 'does not comply'} "
+        f"(peak {isolated.peak_accel_g:.3g} g, stroke {stroke:.3g} m)"
+    )
+    if ok and verified == "screened":
+        status = "passive-mount"
+        note = (
+            f"{base}; {rule}, but its undamped resonance is excited by the transient. "
+            f"Recommended: k1 = {choice.k1:.4g} N/m ({choice.k1 * IN / LBF:.4g} lbf/in) with "
+            f"damping ratio {choice.zeta1:g} (c1 = {choice.c1:.4g} N s/m, "
+            f"f_n = {choice.freq_hz_n:.3g} Hz); {check}"
+        )
+    elif ok:
+        status = "passive-mount"
+        note = f"{base}; Recommended: {rule}; {check}"
+    elif isolated.complies and not visible:
+        status = "no-passive-mount"
+        need_s = 5.0 / (f_n * (2 ** (1 / 6) - 2 ** (-1 / 6)))
+        note = (
+            f"{base}; the only mount that passes (k1 = {mount.k1:.4g} N/m, f_n = "
+            f"{f_n:.3g} Hz) resonates below the lowest band this record resolves "
+            f"({f_floor:.3g} Hz), so the record cannot verify it: not recommended. Lengthen the "
+            f"record to about {need_s:.3g} s to judge it, or use active isolation"
+        )
+    else:
+        status = "no-passive-mount"
+        screen = (
+            f"the screened spring-damper mount (k1 = {choice.k1:.4g} N/m, zeta {choice.zeta1:g}) "
+            "passes the spectral screen but"
+            if choice.found
+            else f"no spring-damper mount of the {choice.screened} screened complies (best "
+            f"margin {choice.min_margin:.3g}); {rule}, and it"
+        )
+        note = (
+            f"{base}; {screen} fails the time-domain check ({check}). No passive mount is "
+            "recommended: active isolation (ARIS-class) is needed for the attenuation listed "
+            "per band"
+        )
+    return IsolationAdvice(
+        point=point,
+        status=status,
+        attenuation_needed=need,
+        band_hz=(lo, hi),
+        target_ma=target,
+        design=design,
+        mount=choice,
+        verified=verified,
+        isolated=isolated,
+        package_accel=pkg,
+        peak_stroke_m=stroke,
+        verifiable=visible,
+        recommended=ok,
+        note=note,
+    )

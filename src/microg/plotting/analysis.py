@@ -1,0 +1,279 @@
+"""Figures of the main job: the model with its points and mode shapes, the forces, the modes,
+and each observed point's history and bands.  They read result objects only.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from microg.units import G0
+
+if TYPE_CHECKING:
+    from microg.analysis import Analysis, Observation
+    from microg.dynamics.modes import Modes
+    from microg.structure.structure import Structure
+
+__all__ = [
+    "analysis_figure",
+    "force_figure",
+    "isolation_figure",
+    "model_figure",
+    "modes_figure",
+    "observation_figure",
+    "sample_displacements",
+]
+
+#: micro-g per m/s^2
+_UG = 1e6 / G0
+
+
+def sample_displacements(structure: Structure, phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Positions (p, 3) of the structure's samples and their displacements (p, 3, m) for phi."""
+    s = structure.samples
+    if s is None:
+        pos = np.array([p.position for p in structure.points.values()]).reshape(-1, 3)
+        u = np.array([p.translation @ phi for p in structure.points.values()]).reshape(
+            -1, 3, phi.shape[1]
+        )
+        return pos, u
+    pos = np.asarray(s.position, float).reshape(-1, 3)
+    if hasattr(s, "displacement"):
+        return pos, np.asarray(s.displacement(phi)).reshape(pos.shape[0], 3, -1)
+    return pos, np.einsum("pin,nm->pim", np.asarray(s.translation, float), phi)
+
+
+def _groups(structure: Structure, n: int) -> list[np.ndarray]:
+    """Sample indices per component (a beam's nodes, a body's masses), ordered along it."""
+    s = structure.samples
+    labels = getattr(s, "labels", None)
+    comp = getattr(s, "component", None)
+    if labels is not None:
+        keys = np.array([lab.split("/", 1)[0].split(":", 1)[0] for lab in labels])
+    elif comp is not None:
+        keys = np.asarray(comp)
+    else:
+        return [np.arange(n)]
+    return [np.flatnonzero(keys == k) for k in dict.fromkeys(keys.tolist())]
+
+
+def _draw(ax: Any, pos: np.ndarray, groups: list[np.ndarray], h: int, v: int, **kw: Any) -> None:
+    for g in groups:
+        if g.size == 0:
+            continue
+        p = pos[g]
+        axis = int(np.argmax(np.ptp(p, axis=0))) if g.size > 1 else 0
+        order = np.argsort(p[:, axis], kind="stable")
+        ax.plot(p[order, h], p[order, v], **kw)
+
+
+def _views(pos: np.ndarray) -> list[tuple[int, int]]:
+    """The two projections with the largest extent: (horizontal axis, vertical axis)."""
+    ext = np.ptp(pos, axis=0) if pos.size else np.ones(3)
+    order = [int(i) for i in np.argsort(-ext, kind="stable")]
+    return [(order[1], order[0]), (order[2], order[0])]
+
+
+def _in_view(pos: np.ndarray, disp: np.ndarray, hv: tuple[int, int]) -> float:
+    """How well a view shows a mode: in-view motion times the view's extent."""
+    h, v = hv
+    motion = float(np.sum(disp[:, h] ** 2 + disp[:, v] ** 2))
+    extent = float(np.ptp(pos[:, h]) + np.ptp(pos[:, v])) if pos.size else 1.0
+    return motion * extent
+
+
+def model_figure(
+    structure: Structure,
+    modes: Modes,
+    force_points: dict[str, np.ndarray],
+    observed: list[str],
+    n_shapes: int = 3,
+) -> Figure:
+    """The model with its force and observed points (two views), and the first mode shapes.
+
+    Parameters
+    ----------
+    structure : Structure
+    modes : Modes
+        Mass-normalised modes; the first ``n_shapes`` elastic ones are drawn, each in the
+        view where it moves most, scaled to 10 % of the model's size.
+    force_points : dict of str to ndarray (3,)
+        Point name -> force direction (unit), drawn as arrows.
+    observed : list of str
+        Observed point names, drawn as squares.
+    n_shapes : int
+        Elastic mode shapes to draw.
+    """
+    elastic = np.flatnonzero(~modes.rigid & (modes.omega > 0))[:n_shapes]
+    pos, u = sample_displacements(structure, modes.phi[:, elastic])
+    groups = _groups(structure, pos.shape[0])
+    views = _views(pos)
+    size = float(np.max(np.ptp(pos, axis=0))) if pos.size else 1.0
+    ncol = max(len(elastic), 2)
+    fig = Figure(figsize=(7.8, 7.6), layout="constrained")
+    grid = fig.add_gridspec(2, ncol * 2)
+    names = "xyz"
+    for col, (h, v) in enumerate(views):
+        ax = fig.add_subplot(grid[0, col * ncol : (col + 1) * ncol])
+        _draw(ax, pos, groups, h, v, color="0.35", lw=1.6, marker=".", ms=3)
+        for name, d in force_points.items():
+            p = structure.points[name].position
+            ax.annotate(
+                "",
+                xy=(p[h] + 0.1 * size * d[h], p[v] + 0.1 * size * d[v]),
+                xytext=(p[h], p[v]),
+                arrowprops={"arrowstyle": "->", "color": "crimson", "lw": 1.8},
+            )
+            ax.plot(p[h], p[v], "o", color="crimson", ms=6)
+            ax.annotate(
+                f"force at {name}",
+                (p[h], p[v]),
+                fontsize=8,
+                color="crimson",
+                xytext=(5, 4),
+                textcoords="offset points",
+            )
+        for name in observed:
+            p = structure.points[name].position
+            ax.plot(p[h], p[v], "s", color="navy", ms=7, mfc="none", mew=1.5)
+            ax.annotate(
+                name,
+                (p[h], p[v]),
+                fontsize=8,
+                color="navy",
+                xytext=(5, -11),
+                textcoords="offset points",
+            )
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.set_xlabel(f"{names[h]} [m]")
+        ax.set_ylabel(f"{names[v]} [m]")
+        ax.set_title(f"{names[h]}-{names[v]} view (force red, observed blue)", fontsize=9)
+        ax.grid(True, alpha=0.3)
+    for k, j in enumerate(elastic):
+        disp = u[:, :, k]
+        # the view in which this mode moves most
+        candidates = [*views, (views[0][0], views[1][0])]
+        h, v = max(candidates, key=lambda hv: _in_view(pos, disp, hv))
+        peak = float(np.max(np.abs(disp))) or 1.0
+        shape = pos + 0.1 * size * disp / peak
+        ax = fig.add_subplot(
+            grid[1, 2 * k : 2 * k + 2] if ncol == len(elastic) else grid[1, k * 2 : k * 2 + 2]
+        )
+        _draw(ax, pos, groups, h, v, color="0.75", lw=1.0)
+        _draw(ax, shape, groups, h, v, color=f"C{k}", lw=1.6)
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.set_title(f"mode {j + 1}: {modes.freq_hz[j]:.3g} Hz ({names[h]}-{names[v]})", fontsize=9)
+        ax.set_xticks([])
+        ax.set_yticks([])
+    return fig
+
+
+def force_figure(disturbances: list[Any], duration_s: float) -> Figure:
+    """Each force history f(t) over the record (N), from its breakpoints."""
+    fig = Figure(figsize=(7.5, 3.2), layout="constrained")
+    ax = fig.subplots()
+    for d in disturbances:
+        f = d.force
+        t = np.r_[0.0, f.timepts, max(duration_s, float(f.timepts[-1]))]
+        y = np.r_[0.0, f.force, f.force[-1]]
+        ax.plot(t, y, lw=1.2, label=f"{f.name} at {d.point}")
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("force [N]")
+    ax.set_title("Disturbances")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8)
+    return fig
+
+
+def modes_figure(result: Analysis) -> Figure:
+    """Frequencies of the computed modes, numbered as in the modes table, used ones filled."""
+    fig = Figure(figsize=(7.5, 3.6), layout="constrained")
+    ax = fig.subplots()
+    m = result.modes
+    num = np.arange(1, m.n_modes + 1)
+    el = m.omega > 0
+    used = result.used & el
+    ax.semilogy(num[used], m.freq_hz[used], "o", ms=4, label="in the response")
+    ax.semilogy(num[el & ~used], m.freq_hz[el & ~used], "o", ms=4, mfc="none", label="not used")
+    ax.axhline(result.options.max_freq_hz, color="k", lw=0.8, ls="--", label="max_freq")
+    ax.set_xlabel("mode number (as in the modes table)")
+    ax.set_ylabel("frequency [Hz]")
+    ax.set_title(f"Modes of {result.model} ({m.n_rigid} rigid-body modes at 0 Hz, not drawn)")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    return fig
+
+
+def _live_axes(accel: np.ndarray) -> list[int]:
+    """Axes whose signal is more than round-off of the largest (1e-9 of it)."""
+    peak = np.max(np.abs(accel), axis=1)
+    top = float(peak.max()) if peak.size else 0.0
+    return [i for i in range(accel.shape[0]) if top > 0 and peak[i] > 1e-9 * top] or [0]
+
+
+def observation_figure(ob: Observation) -> Figure:
+    """Acceleration history (micro-g) and 1/3-octave band RMS against the limit at a point."""
+    r = ob.response
+    a = ob.assessment
+    live = _live_axes(r.acceleration)
+    fig = Figure(figsize=(7.5, 6.4), layout="constrained")
+    ax1, ax2 = fig.subplots(2, 1)
+    for i in live:
+        ax1.plot(r.timepts, r.acceleration[i] * _UG, lw=0.8, label="xyz"[i])
+    ax1.set_xlabel("time [s]")
+    ax1.set_ylabel("acceleration [micro-g]")
+    ax1.set_title(f"Acceleration at {ob.name} (peak {a.peak_accel_g:.3g} g)")
+    ax1.grid(True, alpha=0.3)
+    ax1.legend(fontsize=8)
+    to = a.third_octave
+    for i in live:
+        ax2.loglog(
+            to.center_hz, np.maximum(to.rms_g[i] * 1e6, 1e-30), "o-", ms=3, lw=0.8, label="xyz"[i]
+        )
+    edges = np.r_[to.lower_hz, to.upper_hz[-1:]]
+    ax2.stairs(to.limit_g * 1e6, edges, color="k", lw=1.4, label="limit")
+    ax2.set_xlabel("frequency [Hz]")
+    ax2.set_ylabel("band RMS [micro-g]")
+    ax2.grid(True, which="both", alpha=0.3)
+    ax2.legend(fontsize=8)
+    return fig
+
+
+def isolation_figure(ob: Observation) -> Figure:
+    """Mount acceleration against what the isolated package feels, on the dominant axis."""
+    adv = ob.isolation
+    pkg = adv.package_accel
+    r = ob.response
+    fig = Figure(figsize=(7.5, 3.8), layout="constrained")
+    ax = fig.subplots()
+    axis = int(np.argmax(np.max(np.abs(r.acceleration), axis=1)))
+    ax.plot(r.timepts, r.acceleration[axis] * _UG, lw=0.8, label="mount (station)")
+    if pkg is not None:
+        label = "isolated package" + ("" if adv.recommended else " (mount NOT recommended)")
+        ax.plot(r.timepts, pkg[axis] * _UG, lw=0.9, label=label)
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel(f"acceleration, {'xyz'[axis]} [micro-g]")
+    ax.set_title(f"Isolation check at {ob.name}: {adv.status}")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8)
+    return fig
+
+
+def analysis_figure(result: Analysis) -> Figure:
+    """Peak acceleration at each observed point against the report's 1e-5 g."""
+    from microg.analysis import REPORT_LIMIT_G
+
+    fig = Figure(figsize=(7.5, 3.4), layout="constrained")
+    ax = fig.subplots()
+    names = list(result.observations)
+    peaks = [result.observations[n].peak_accel_g for n in names]
+    colors = ["tab:green" if result.observations[n].complies else "tab:red" for n in names]
+    ax.bar(names, peaks, color=colors)
+    ax.axhline(REPORT_LIMIT_G, color="k", ls="--", lw=0.8, label="report's 1e-5 g")
+    ax.set_yscale("log")
+    ax.set_ylabel("peak acceleration [g]")
+    ax.set_title("Peak at each observed point (green: band verdict complies)")
+    ax.legend(fontsize=8)
+    return fig
