@@ -250,9 +250,7 @@ def advise_isolation(
     k_floor = package_mass * (2 * np.pi * f_floor) ** 2
     k_max = 10.0 * design.k1
     decades = float(np.clip(np.log10(k_max / k_floor), 0.5, 4.0)) if k_max > k_floor else 0.5
-    choice = search_mount(
-        assessment.spectrum, requirement, package_mass, k_max, decades=decades
-    )
+    choice = search_mount(assessment.spectrum, requirement, package_mass, k_max, decades=decades)
     if choice.found:
         mount = IsolatorModel(m1=package_mass, k1=choice.k1, c1=choice.c1)
         verified = "screened"

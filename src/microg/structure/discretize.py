@@ -46,8 +46,11 @@ def discretize(
 
     Parameters
     ----------
-    model : Station, or an object with a ``to_structure()`` method (imported modal models)
-        The model, SI.
+    model : Station, GraphModel or ModalModel
+        The model, SI.  A general frame (graph) model is assembled by
+        :func:`microg.structure.frame.build_frame`; an imported modal model becomes a
+        structure in modal coordinates (:func:`microg.structure.modal.modal_structure`);
+        ``method``, ``plane`` and ``n`` apply to tree station models only.
     method : {"fem", "ritz"}
         3-D frame finite elements, or assumed modes (Rayleigh-Ritz).
     plane : {"3d", "xz", "yz"}
@@ -62,12 +65,17 @@ def discretize(
     -------
     Structure
     """
-    to_structure = getattr(model, "to_structure", None)
-    if callable(to_structure):
-        structure = to_structure()
-        if not isinstance(structure, Structure):
-            raise TypeError("to_structure() must return a Structure")
-        return structure
+    kind = type(model).__name__
+    if kind == "ModalModel":
+        from microg.structure.modal import modal_structure
+
+        return modal_structure(model)
+    if kind == "GraphModel":
+        from microg.structure.frame import build_frame
+
+        return build_frame(model)
+    if isinstance(model, Structure):
+        return model
     if method not in METHODS:
         raise InputError(f"unknown method {method!r}", where="method", fix="use fem or ritz")
     if plane not in PLANES:
