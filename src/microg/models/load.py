@@ -1,0 +1,126 @@
+"""One entry to every model kind: ``load_model(path, units=..., wtmass=..., points=...)``.
+
+Dispatch by suffix:
+
+* ``.op2``: NASTRAN SOL 103 results (:func:`microg.models.nastran.modal_model_from_op2`);
+* ``.op4``: NASTRAN matrices MAA/KAA with a DOF map beside (``<stem>.dofmap.csv``: one row
+  ``grid, component, x, y, z`` per a-set DOF, positions in the file's length unit);
+* ``.unv`` / ``.uff``: UFF 15/2411 + 55 (+164) (:func:`microg.models.uff.modal_model_from_uff`);
+* ``.npz``: microg's own modal-model file (:func:`microg.models.modal.load_modal_model`);
+* ``.toml`` or a shipped name: a station (:func:`microg.models.toml.load_station`);
+* ``.bdf`` / ``.dat``: a NASTRAN deck, solved by microg's frame FE (``microg.models.bdf``).
+
+NASTRAN files declare no units: ``units`` (``"in, lbf, s"``) is required for them, from the
+argument or the points file; a missing declaration is an error, never a guess.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from microg.errors import InputError
+from microg.models.modal import ModelOptions, load_modal_model, parse_units, read_options
+
+__all__ = ["load_model", "MODEL_SUFFIXES"]
+
+MODEL_SUFFIXES = (".op2", ".op4", ".unv", ".uff", ".npz", ".toml", ".bdf", ".dat")
+
+
+def _units(
+    units: str | None, wtmass: float | None, opts: ModelOptions, path: str, need: bool
+) -> Any:
+    text = units if units is not None else opts.units
+    wt = wtmass if wtmass is not None else opts.wtmass
+    if text is None:
+        if need:
+            raise InputError(
+                "NASTRAN files declare no units and none was given",
+                where=path,
+                fix='state them, e.g. units = "in, lbf, s" (points file) or --units "in,lbf,s"',
+            )
+        return None
+    return parse_units(text, where="units", wtmass=wt)
+
+
+def load_model(
+    path: str | Path,
+    units: str | None = None,
+    wtmass: float | None = None,
+    points: str | Path | None = None,
+) -> Any:
+    """Read a model of any kind microg knows (see the module docstring).
+
+    Parameters
+    ----------
+    path : str or Path
+        Model file, or the name of a shipped station model.
+    units : str, optional
+        ``"LENGTH, FORCE, TIME"`` of a NASTRAN file (or of a UFF file without dataset 164).
+    wtmass : float, optional
+        NASTRAN PARAM,WTMASS of the run.
+    points : str or Path, optional
+        Points/options TOML file (named grids, kinds, and optionally ``units``/``wtmass``).
+
+    Returns
+    -------
+    ModalModel or Station
+    """
+    opts = read_options(points) if points is not None else ModelOptions()
+    p = Path(path)
+    suffix = p.suffix.lower()
+    label = str(path)
+    if suffix not in MODEL_SUFFIXES:
+        from microg.models.toml import load_station
+
+        if opts.points:
+            raise InputError("a points file applies to modal models only", where=str(points))
+        return load_station(path)
+    if suffix == ".toml":
+        from microg.models.toml import load_station
+
+        return load_station(p)
+    if suffix in (".bdf", ".dat"):
+        try:
+            from microg.models import bdf
+        except ImportError:
+            raise InputError("the NASTRAN deck reader is not available yet", where=label) from None
+        u = _units(units, wtmass, opts, label, need=True)
+        return bdf.load_bdf(p, units=u, points=opts.points)
+    if not p.is_file():
+        raise InputError("no such file", where=label)
+    if suffix == ".npz":
+        return load_modal_model(p, points=opts.points)
+    if suffix in (".unv", ".uff"):
+        from microg.models.uff import modal_model_from_uff
+
+        u = _units(units, wtmass, opts, label, need=False)
+        return modal_model_from_uff(p, units=u, points=opts.points)
+    if suffix == ".op2":
+        from microg.models.nastran import modal_model_from_op2
+
+        u = _units(units, wtmass, opts, label, need=True)
+        return modal_model_from_op2(p, u, points=opts.points)
+    from microg.models.nastran import modal_model_from_op4
+
+    u = _units(units, wtmass, opts, label, need=True)
+    side = p.with_suffix(".dofmap.csv")
+    if not side.is_file():
+        raise InputError(
+            f"an OP4 needs its DOF map beside it ({side.name}: grid, component, x, y, z per "
+            "a-set DOF)",
+            where=label,
+        )
+    try:
+        rows = np.loadtxt(side, delimiter=",", ndmin=2, comments="#")
+    except ValueError as exc:
+        raise InputError(f"cannot read the DOF map: {exc}", where=str(side)) from None
+    if rows.shape[1] != 5:
+        raise InputError("DOF map rows must be grid, component, x, y, z", where=str(side))
+    dof_map = rows[:, :2].astype(int)
+    ids, first = np.unique(dof_map[:, 0], return_index=True)
+    return modal_model_from_op4(
+        p, u, dof_map=dof_map, xyz=rows[first, 2:5], grid_ids=ids, points=opts.points
+    )

@@ -1,0 +1,987 @@
+"""NASTRAN SOL 103 results: OP2 (eigenvalues, eigenvectors, geometry) and OP4 matrices.
+
+OP2 reader (microg's own, pure numpy; no third-party reader works on numpy 2 for every
+table needed here):
+
+* the OUTPUT2 record structure, little- or big-endian, 32- or 64-bit words, with or
+  without the "NASTRAN FORT TAPE ID CODE" header (MSC and Simcenter/NX files);
+* ``LAMA``: mode number, extraction order, eigenvalue, radians, cycles, generalized mass
+  and stiffness of each real mode;
+* ``OUGV1`` / ``BOUGV1`` real eigenvectors (approach code 2, table code 7) in SORT1 (one
+  record per mode) and SORT2 (one record per grid), grids and scalar points;
+* geometry: ``GEOM1``/``GEOM1S`` GRID and CORD2R/C/S cards (coordinate systems chained
+  through their reference systems), else ``BGPDT``/``BGPDTS`` + ``EQEXIN``/``EQEXINS``;
+  eigenvectors in a grid's output system (CD) are rotated to the basic frame (cylindrical
+  and spherical systems at the grid's own angles), unless the table is BOUGV1 or PARAM
+  OUGCORD is BASIC;
+* ``OGPWG``: the grid point weight generator's 6x6 rigid-body mass about its reference
+  point (input mass units, so times WTMASS), used for exact rigid-body modes;
+* ``PVT0``: the run's PARAMs (WTMASS, OUGCORD, GRDPNT).
+
+OP4 matrices (MAA, KAA, a mode-shape/recovery matrix) are read by pyyeti's OP4 reader
+(numpy 2 ready), imported lazily: without it, one line names the extra.
+
+Everything a file gives is in the file's units; :func:`modal_model_from_op2` converts to SI
+with the user's unit declaration (:func:`microg.models.modal.parse_units`).
+"""
+
+from __future__ import annotations
+
+import struct
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from microg.errors import InputError
+from microg.models.modal import (
+    ModalModel,
+    ModalPoint,
+    UnitSystem,
+    build_modal_model,
+    nearest_ids,
+)
+
+__all__ = [
+    "CoordSystem",
+    "Op2File",
+    "Op2Modes",
+    "Op4Model",
+    "read_op2_modes",
+    "modal_model_from_op2",
+    "read_op4",
+    "modal_model_from_op4",
+    "EXTRA_HINT",
+]
+
+EXTRA_HINT = 'pip install "microg[nastran]"'
+
+
+# --------------------------------------------------------------------------- records
+
+
+class Op2File:
+    """The data blocks of an OP2 file: name -> list of tables, each a list of records.
+
+    Attributes
+    ----------
+    path : str
+    endian : str
+        ``"<"`` or ``">"``.
+    word : int
+        4 (32-bit) or 8 (64-bit) bytes.
+    tables : list of (name, trailer, records)
+        In file order; ``records`` are the logical records' bytes (record 0 is the
+        header record holding the name).
+    """
+
+    def __init__(self, path: str | Path):
+        self.path = str(path)
+        try:
+            data = Path(path).read_bytes()
+        except FileNotFoundError:
+            raise InputError("no such file", where=self.path) from None
+        except OSError as exc:
+            raise InputError(f"cannot read: {exc.strerror or exc}", where=self.path) from None
+        if len(data) < 8:
+            raise InputError("not an OP2 file (shorter than one record)", where=self.path)
+        first_le = struct.unpack("<i", data[:4])[0]
+        first_be = struct.unpack(">i", data[:4])[0]
+        if first_le in (4, 8):
+            self.endian, self.word = "<", first_le
+        elif first_be in (4, 8):
+            self.endian, self.word = ">", first_be
+        else:
+            raise InputError(
+                "not an OP2 file (the first Fortran record marker is not 4 or 8)",
+                where=self.path,
+            )
+        self._data = data
+        self._records = self._scan(data)
+        self.tables = self._split()
+
+    def _fail(self, what: str) -> InputError:
+        return InputError(f"truncated or corrupt OP2: {what}", where=self.path)
+
+    def _scan(self, data: bytes) -> list[tuple[int, int]]:
+        n = len(data)
+        fmt = self.endian + "i"
+        out = []
+        i = 0
+        while i < n:
+            if i + 4 > n:
+                raise self._fail(f"a record marker is cut at byte {i}")
+            length = struct.unpack_from(fmt, data, i)[0]
+            end = i + 4 + length
+            if length < 0 or end + 4 > n:
+                raise self._fail(f"the record at byte {i} runs past the end of the file")
+            if struct.unpack_from(fmt, data, end)[0] != length:
+                raise self._fail(f"the record at byte {i} has mismatched length markers")
+            out.append((i + 4, end))
+            i = end + 4
+        return out
+
+    def _key(self, k: int) -> int | None:
+        if k >= len(self._records):
+            return None
+        a, b = self._records[k]
+        if b - a != self.word:
+            return None
+        return int(
+            struct.unpack_from(self.endian + ("i" if self.word == 4 else "q"), self._data, a)[0]
+        )
+
+    def _bytes(self, k: int) -> bytes:
+        a, b = self._records[k]
+        return self._data[a:b]
+
+    def _split(self) -> list[tuple[str, np.ndarray, list[bytes]]]:
+        recs = self._records
+        k = 0
+        if self._key(0) == 3 and len(recs) > 1 and recs[1][1] - recs[1][0] == 3 * self.word:
+            # MSC header: date, "NASTRAN FORT TAPE ID CODE", label, then -1, 0
+            while k < len(recs) and self._key(k) != 0:
+                k += 1
+            k += 1
+        tables = []
+        while k < len(recs):
+            n = self._key(k)
+            if n is None:
+                raise self._fail(f"expected a data block name at record {k}")
+            if n == 0:
+                break
+            if k + 8 > len(recs):
+                raise self._fail("a data block header is cut")
+            name = self._bytes(k + 1)[:8].decode("latin1").strip()
+            trailer = np.frombuffer(
+                self._bytes(k + 4), self.endian + ("i4" if self.word == 4 else "i8")
+            )
+            k += 8
+            logical: list[bytes] = []
+            while True:
+                n = self._key(k)
+                if n is None:
+                    raise self._fail(f"data block {name} ends without its end marker")
+                if n == 0:
+                    k += 1
+                    break
+                if n > 0:
+                    parts = []
+                    while n is not None and n > 0:
+                        if k + 1 >= len(recs):
+                            raise self._fail(f"data block {name} is cut")
+                        parts.append(self._bytes(k + 1))
+                        k += 2
+                        n = self._key(k)
+                    logical.append(b"".join(parts))
+                if n is None or n >= 0:
+                    raise self._fail(f"data block {name}: bad record marker at record {k}")
+                k += 3  # -r, 1, 0
+            tables.append((name, trailer, logical))
+        return tables
+
+    def ints(self, rec: bytes) -> np.ndarray:
+        """Record as integers."""
+        return np.frombuffer(rec, self.endian + ("i4" if self.word == 4 else "i8"))
+
+    def floats(self, rec: bytes) -> np.ndarray:
+        """Record as reals."""
+        return np.frombuffer(rec, self.endian + ("f4" if self.word == 4 else "f8"))
+
+    def named(self, *names: str) -> list[tuple[str, np.ndarray, list[bytes]]]:
+        """Tables whose name is one of ``names``, in file order."""
+        return [t for t in self.tables if t[0] in names]
+
+
+# --------------------------------------------------------------------------- coordinates
+
+
+@dataclass(frozen=True)
+class CoordSystem:
+    """A NASTRAN coordinate system in the basic frame.
+
+    Attributes
+    ----------
+    cid : int
+    kind : str
+        ``"R"``, ``"C"`` or ``"S"``.
+    origin : ndarray (3,)
+        Basic coordinates of the origin.
+    axes : ndarray (3, 3)
+        Columns: the system's x, y, z unit vectors in basic.
+    """
+
+    cid: int
+    kind: str
+    origin: np.ndarray
+    axes: np.ndarray
+
+    def to_basic(self, x: np.ndarray) -> np.ndarray:
+        """Basic positions (n, 3) of coordinates ``x`` (n, 3) given in this system
+        (R: x, y, z; C: r, theta deg, z; S: r, theta deg, phi deg)."""
+        return self.origin + _local_rect(self.kind, np.asarray(x, float)) @ self.axes.T
+
+    def directions(self, xyz_basic: np.ndarray) -> np.ndarray:
+        """Output directions (n, 3, 3) at basic points: columns are the unit vectors of the
+        system's components (x, y, z; r, theta, z; r, theta, phi) in basic."""
+        p = (np.asarray(xyz_basic, float) - self.origin) @ self.axes  # local rectangular
+        n = p.shape[0]
+        if self.kind == "R":
+            local = np.broadcast_to(np.eye(3), (n, 3, 3))
+        elif self.kind == "C":
+            th = np.arctan2(p[:, 1], p[:, 0])
+            c, s = np.cos(th), np.sin(th)
+            z, o = np.zeros(n), np.ones(n)
+            local = np.stack(
+                [np.stack([c, s, z], -1), np.stack([-s, c, z], -1), np.stack([z, z, o], -1)], -1
+            )
+        else:
+            r_xy = np.hypot(p[:, 0], p[:, 1])
+            th = np.arctan2(r_xy, p[:, 2])
+            ph = np.arctan2(p[:, 1], p[:, 0])
+            st, ct, sp, cp = np.sin(th), np.cos(th), np.sin(ph), np.cos(ph)
+            z = np.zeros(n)
+            local = np.stack(
+                [
+                    np.stack([st * cp, st * sp, ct], -1),
+                    np.stack([ct * cp, ct * sp, -st], -1),
+                    np.stack([-sp, cp, z], -1),
+                ],
+                -1,
+            )
+        return np.einsum("ab,nbc->nac", self.axes, local)
+
+
+def _local_rect(kind: str, x: np.ndarray) -> np.ndarray:
+    if kind == "R":
+        return x
+    if kind == "C":
+        r, th = x[..., 0], np.radians(x[..., 1])
+        return np.stack([r * np.cos(th), r * np.sin(th), x[..., 2]], -1)
+    r, th, ph = x[..., 0], np.radians(x[..., 1]), np.radians(x[..., 2])
+    return np.stack([r * np.sin(th) * np.cos(ph), r * np.sin(th) * np.sin(ph), r * np.cos(th)], -1)
+
+
+BASIC = CoordSystem(0, "R", np.zeros(3), np.eye(3))
+
+
+def cord2_system(
+    cid: int, kind: str, a: np.ndarray, b: np.ndarray, c: np.ndarray, ref: CoordSystem
+) -> CoordSystem:
+    """A CORD2R/C/S system from its points A (origin), B (on z), C (in the xz plane), given in
+    the reference system ``ref``."""
+    pa, pb, pc = ref.to_basic(np.array([a, b, c], float))
+    ez = pb - pa
+    if np.linalg.norm(ez) == 0:
+        raise ValueError(f"CORD2{kind} {cid}: points A and B coincide")
+    ez = ez / np.linalg.norm(ez)
+    ey = np.cross(ez, pc - pa)
+    if np.linalg.norm(ey) == 0:
+        raise ValueError(f"CORD2{kind} {cid}: point C is on the z axis")
+    ey = ey / np.linalg.norm(ey)
+    ex = np.cross(ey, ez)
+    return CoordSystem(cid, kind, pa, np.column_stack([ex, ey, ez]))
+
+
+def resolve_cord2(
+    cards: Sequence[tuple[int, str, int, np.ndarray]], where: str
+) -> dict[int, CoordSystem]:
+    """Chain CORD2 cards ``(cid, kind, rid, [A, B, C] (9,))`` to basic."""
+    systems: dict[int, CoordSystem] = {0: BASIC}
+    pending = {int(cid): (kind, int(rid), np.asarray(v, float)) for cid, kind, rid, v in cards}
+    while pending:
+        done = [cid for cid, (_, rid, _) in pending.items() if rid in systems]
+        if not done:
+            cid = sorted(pending)[0]
+            raise InputError(
+                f"coordinate system {cid} refers to system {pending[cid][1]}, which is not "
+                "defined (or the references loop)",
+                where=where,
+            )
+        for cid in done:
+            kind, rid, v = pending.pop(cid)
+            try:
+                systems[cid] = cord2_system(cid, kind, v[:3], v[3:6], v[6:9], systems[rid])
+            except ValueError as exc:
+                raise InputError(str(exc), where=where) from None
+    return systems
+
+
+# --------------------------------------------------------------------------- OP2 tables
+
+
+@dataclass(frozen=True)
+class Op2Modes:
+    """Real modes read from an OP2, in the file's units and output systems.
+
+    Attributes
+    ----------
+    path : str
+    table : str
+        ``"OUGV1"`` or ``"BOUGV1"``.
+    sort : str
+        ``"SORT1"`` or ``"SORT2"``.
+    mode : ndarray (m,) int
+    eigenvalue : ndarray (m,)
+        omega^2 in 1/time^2 (LAMA).
+    generalized_mass : ndarray (m,)
+        LAMA's generalized masses (mass x length^2 in consistent units).
+    grid_ids : ndarray (g,) int
+        Grids (scalar points excluded).
+    shapes : ndarray (g, 6, m)
+        Eigenvector components T1..R3 as in the file (each grid's output system).
+    cd : ndarray (g,) int
+        Output system of each grid's components (0 when the table is in basic).
+    xyz_basic : ndarray (g, 3) or None
+        Grid positions in basic (file length unit).
+    coords : dict of int to CoordSystem
+    rigid_mass : ndarray (6, 6) or None
+        OGPWG's MO about ``rigid_mass_ref`` (input mass units: multiply by WTMASS).
+    rigid_mass_ref : ndarray (3,) or None
+        Basic coordinates of the OGPWG reference point.
+    params : dict
+        PARAMs from PVT0.
+    n_scalar : int
+        Scalar points dropped.
+    """
+
+    path: str
+    table: str
+    sort: str
+    mode: np.ndarray
+    eigenvalue: np.ndarray
+    generalized_mass: np.ndarray
+    grid_ids: np.ndarray
+    shapes: np.ndarray
+    cd: np.ndarray
+    xyz_basic: np.ndarray | None
+    coords: dict[int, CoordSystem] = field(default_factory=dict)
+    rigid_mass: np.ndarray | None = None
+    rigid_mass_ref: np.ndarray | None = None
+    params: dict[str, Any] = field(default_factory=dict)
+    n_scalar: int = 0
+
+    @property
+    def freq_hz_signed(self) -> np.ndarray:
+        """sign(eigenvalue) sqrt(|eigenvalue|) / 2 pi, Hz (file time unit)."""
+        lam = self.eigenvalue
+        return np.sign(lam) * np.sqrt(np.abs(lam)) / (2.0 * np.pi)
+
+    def shapes_basic(self) -> np.ndarray:
+        """Eigenvectors rotated from each grid's output system to basic, (g, 6, m)."""
+        out = np.array(self.shapes, dtype=float)
+        for cid in np.unique(self.cd):
+            if cid == 0:
+                continue
+            sel = np.flatnonzero(self.cd == cid)
+            cs = self.coords.get(int(cid))
+            if cs is None:
+                raise InputError(
+                    f"grids {', '.join(str(g) for g in self.grid_ids[sel[:5]])} give output in "
+                    f"coordinate system {cid}, which the file does not define",
+                    where=self.path,
+                    fix="give the BDF (with its CORD2 cards) beside the OP2",
+                )
+            if self.xyz_basic is None:
+                raise InputError("no grid geometry to rotate output systems", where=self.path)
+            t = cs.directions(self.xyz_basic[sel])  # (n, 3, 3)
+            out[sel, :3] = np.einsum("nab,nbm->nam", t, out[sel, :3])
+            out[sel, 3:] = np.einsum("nab,nbm->nam", t, out[sel, 3:])
+        return out
+
+
+def _pvt0(f: Op2File) -> dict[str, Any]:
+    params: dict[str, Any] = {}
+    for _, _, recs in f.named("PVT0"):
+        if len(recs) < 2:
+            continue
+        ints, flts = f.ints(recs[1]), f.floats(recs[1])
+        raw = recs[1]
+        w = f.word
+        i = 0
+        try:
+            while i + 3 <= ints.size:
+                name = raw[i * w : (i + 2) * w].decode("latin1")
+                name = name.replace("\x00", " ")[: 8 if w == 4 else 16].strip()
+                kind = int(ints[i + 2])
+                i += 3
+                if kind == 1:
+                    params[name] = int(ints[i])
+                    i += 1
+                elif kind == 2:
+                    params[name] = float(flts[i])
+                    i += 1
+                elif kind == 3:
+                    params[name] = raw[i * w : (i + 2) * w].decode("latin1").strip()
+                    i += 2
+                elif kind == 4:
+                    params[name] = (
+                        float(np.frombuffer(raw[i * w : (i + 2) * w], f.endian + "f8")[0])
+                        if w == 4
+                        else float(flts[i])
+                    )
+                    i += 2 if w == 4 else 1
+                elif kind == 5:
+                    i += 2
+                elif kind == 6:
+                    i += 4 if w == 4 else 2
+                else:
+                    break
+        except (IndexError, UnicodeDecodeError, ValueError):
+            pass
+    return params
+
+
+def _lama(f: Op2File) -> np.ndarray | None:
+    """(m, 7): mode, order, eigenvalue, radians, cycles, genmass, genstiff."""
+    for _, _, recs in f.named("LAMA"):
+        if len(recs) < 3:
+            continue
+        data = recs[2]
+        n = len(data) // (7 * f.word)
+        if n * 7 * f.word != len(data):
+            raise InputError("LAMA record length is not 7 words per mode", where=f.path)
+        ints = f.ints(data).reshape(n, 7)
+        flt = f.floats(data).reshape(n, 7)
+        out = np.empty((n, 7))
+        out[:, :2] = ints[:, :2]
+        out[:, 2:] = flt[:, 2:]
+        return out
+    return None
+
+
+def _geometry(f: Op2File) -> tuple[dict[int, tuple[int, np.ndarray, int]], dict[int, CoordSystem]]:
+    """Grid id -> (cp, x in cp, cd) and the coordinate systems, from GEOM1/GEOM1S."""
+    grids: dict[int, tuple[int, np.ndarray, int]] = {}
+    cords: dict[int, tuple[int, str, int, np.ndarray]] = {}
+    kinds = {(2101, 21, 8): "R", (2001, 20, 9): "C", (2201, 22, 10): "S"}
+    w = f.word
+    for _, _, recs in f.named("GEOM1", "GEOM1S"):
+        for rec in recs[1:]:
+            ints = f.ints(rec)
+            if ints.size < 3:
+                continue
+            head = tuple(int(v) for v in ints[:3])
+            body_i, body_f = ints[3:], f.floats(rec)[3:]
+            if head == (4501, 45, 1):
+                n = body_i.size // 8
+                bi, bf = body_i[: 8 * n].reshape(n, 8), body_f[: 8 * n].reshape(n, 8)
+                for r in range(n):
+                    grids.setdefault(
+                        int(bi[r, 0]), (int(bi[r, 1]), bf[r, 2:5].astype(float), int(bi[r, 5]))
+                    )
+            elif head in kinds:
+                n = body_i.size // 13
+                bi, bf = body_i[: 13 * n].reshape(n, 13), body_f[: 13 * n].reshape(n, 13)
+                for r in range(n):
+                    cid = int(bi[r, 0])
+                    cords.setdefault(
+                        cid, (cid, kinds[head], int(bi[r, 3]), bf[r, 4:13].astype(float))
+                    )
+            elif head[:2] in ((1701, 17), (1801, 18), (1901, 19)):
+                raise InputError(
+                    "CORD1R/C/S systems (defined by grids) are not supported in the OP2 geometry",
+                    where=f.path,
+                    fix="use CORD2R/C/S, or output in basic (PARAM,OUGCORD,BASIC)",
+                )
+    del w
+    systems = resolve_cord2(list(cords.values()), f.path)
+    return grids, systems
+
+
+def _bgpdt(f: Op2File) -> dict[int, tuple[int, np.ndarray]]:
+    """Grid id -> (cd, basic xyz) from BGPDT(S) + EQEXIN(S) (older 4-word layout)."""
+    out: dict[int, tuple[int, np.ndarray]] = {}
+    bg = f.named("BGPDT", "BGPDTS")
+    eq = f.named("EQEXIN", "EQEXINS")
+    for (_, _, brecs), (_, _, erecs) in zip(bg, eq, strict=False):
+        if len(brecs) < 2 or len(erecs) < 2:
+            continue
+        e1 = f.ints(erecs[1]).reshape(-1, 2)  # external id, internal id
+        rec = brecs[1]
+        n = e1.shape[0]
+        nw = len(rec) // f.word
+        if nw != 4 * n:
+            continue  # newer layouts: GEOM1 carries the geometry instead
+        bi, bf = f.ints(rec).reshape(n, 4), f.floats(rec).reshape(n, 4)
+        internal = {int(i): int(e) for e, i in e1}
+        for row in range(n):
+            ext = internal.get(row + 1)
+            if ext is not None and bi[row, 0] >= 0:
+                out.setdefault(ext, (int(bi[row, 0]), bf[row, 1:4].astype(float)))
+    return out
+
+
+def _ogpwg(f: Op2File) -> tuple[np.ndarray, int] | None:
+    for _, _, recs in f.named("OGPWG"):
+        if len(recs) < 3:
+            continue
+        ident = f.ints(recs[1])
+        data = f.floats(recs[2]).astype(float)
+        if data.size < 36:
+            continue
+        return data[:36].reshape(6, 6), int(ident[2]) if ident.size > 2 else 0
+    return None
+
+
+def _eigenvector_tables(f: Op2File) -> list[tuple[str, list[bytes]]]:
+    out = []
+    for name, _, recs in f.named("OUGV1", "BOUGV1", "OUGV2", "BOUGV2"):
+        if len(recs) >= 3:
+            ident = f.ints(recs[1])
+            if ident.size >= 10 and ident[0] // 10 == 2 and ident[1] % 1000 == 7:
+                out.append((name, recs))
+    return out
+
+
+def _read_ougv(
+    f: Op2File, name: str, recs: list[bytes], lama: np.ndarray | None
+) -> tuple[str, np.ndarray, np.ndarray, np.ndarray, np.ndarray, int]:
+    """(sort, mode numbers, eigenvalues from the records, grid ids, shapes (g, 6, m), n_scalar)."""
+    w = f.word
+    pairs = [(recs[i], recs[i + 1]) for i in range(1, len(recs) - 1, 2)]
+    first = f.ints(pairs[0][0])
+    tcode = int(first[1])
+    sort2 = bool((tcode // 1000) & 2)
+    if (tcode // 1000) & 1 or int(first[8]) not in (0, 1) or int(first[9]) != 8:
+        raise InputError(
+            f"{name} holds complex or non-standard eigenvectors (format {int(first[8])}, "
+            f"{int(first[9])} words per entry); only real modes are read",
+            where=f.path,
+        )
+    if not sort2:
+        modes, eig, data = [], [], []
+        for ident, rec in pairs:
+            ii = f.ints(ident)
+            modes.append(int(ii[4]))
+            eig.append(float(f.floats(ident)[5]))
+            data.append(rec)
+        n = len(data[0]) // (8 * w)
+        if any(len(d) != n * 8 * w for d in data):
+            raise InputError(f"{name}: modes have different numbers of points", where=f.path)
+        ints = f.ints(data[0]).reshape(n, 8)
+        ids, types = ints[:, 0] // 10, ints[:, 1]
+        vals = np.stack([f.floats(d).reshape(n, 8)[:, 2:] for d in data], axis=-1)
+    else:
+        ids_l, types_l, cols = [], [], []
+        modes_arr = None
+        for ident, rec in pairs:
+            ii = f.ints(ident)
+            nrow = len(rec) // (8 * w)
+            ri, rf = f.ints(rec).reshape(nrow, 8), f.floats(rec).reshape(nrow, 8)
+            ids_l.append(int(ii[4]) // 10)
+            types_l.append(int(ri[0, 1]))
+            cols.append(rf[:, 2:].T)  # (6, m)
+            if modes_arr is None:
+                key_i = ri[:, 0]
+                if lama is not None and np.all((key_i >= 1) & (key_i <= 10**7)):
+                    modes_arr = key_i.astype(int)
+                elif lama is not None:
+                    lam = lama[:, 2]
+                    key_f = rf[:, 0].astype(float)
+                    modes_arr = np.array([int(lama[np.argmin(np.abs(lam - v)), 0]) for v in key_f])
+                else:
+                    modes_arr = np.arange(1, nrow + 1)
+        ids, types = np.array(ids_l), np.array(types_l)
+        vals = np.stack(cols, axis=0)  # (n, 6, m)
+        modes = list(modes_arr) if modes_arr is not None else []
+        eig = [float("nan")] * len(modes)
+    scalar = types != 1
+    keep = ~scalar
+    return (
+        "SORT2" if sort2 else "SORT1",
+        np.asarray(modes, int),
+        np.asarray(eig, float),
+        np.asarray(ids[keep], np.int64),
+        np.asarray(vals[keep], float),
+        int(np.count_nonzero(scalar)),
+    )
+
+
+def read_op2_modes(path: str | Path) -> Op2Modes:
+    """Read the real modes of a SOL 103 OP2 (see the module docstring).
+
+    Raises
+    ------
+    InputError
+        Not an OP2, truncated or corrupt, no eigenvectors or no eigenvalue table (one line
+        naming the file).
+    """
+    f = Op2File(path)
+    tables = _eigenvector_tables(f)
+    lama = _lama(f)
+    if not tables:
+        names = ", ".join(sorted({t[0] for t in f.tables})) or "none"
+        raise InputError(
+            f"no real eigenvectors (no OUGV1/BOUGV1 table of SOL 103 modes; data blocks: {names})",
+            where=f.path,
+            fix="rerun with DISPLACEMENT(PLOT) = ALL and PARAM,POST,-1 or -2",
+        )
+    name, recs = tables[0]
+    sort, modes, eig_id, ids, shapes, n_scalar = _read_ougv(f, name, recs, lama)
+    if lama is None:
+        raise InputError(
+            "no LAMA table (eigenvalues and generalized masses)",
+            where=f.path,
+            fix="rerun SOL 103 with PARAM,POST so that LAMA is written",
+        )
+    row = {int(mn): r for r, mn in enumerate(lama[:, 0].astype(int))}
+    missing = [int(mn) for mn in modes if int(mn) not in row]
+    if missing:
+        raise InputError(
+            f"{name} mode {missing[0]} has no LAMA entry", where=f.path, fix="check the file"
+        )
+    sel = np.array([row[int(mn)] for mn in modes])
+    params = _pvt0(f)
+    grids, systems = _geometry(f)
+    xyz = None
+    cd = np.zeros(ids.size, int)
+    if grids:
+        miss = [int(g) for g in ids if int(g) not in grids]
+        if miss:
+            raise InputError(
+                f"grid {miss[0]} of {name} is not in the OP2's GEOM1 table", where=f.path
+            )
+        cps = np.array([grids[int(g)][0] for g in ids])
+        local = np.array([grids[int(g)][1] for g in ids])
+        cd = np.array([grids[int(g)][2] for g in ids])
+        xyz = np.zeros((ids.size, 3))
+        for cp in np.unique(cps):
+            cs = systems.get(int(cp))
+            if cs is None:
+                raise InputError(
+                    f"grids refer to coordinate system {cp}, not defined in the OP2", where=f.path
+                )
+            m = cps == cp
+            xyz[m] = cs.to_basic(local[m])
+    else:
+        bg = _bgpdt(f)
+        if bg and all(int(g) in bg for g in ids):
+            cd = np.array([bg[int(g)][0] for g in ids])
+            xyz = np.array([bg[int(g)][1] for g in ids])
+    basic_output = name.startswith("B") or str(params.get("OUGCORD", "")).upper() == "BASIC"
+    if basic_output:
+        cd = np.zeros(ids.size, int)
+    gp = _ogpwg(f)
+    rm = ref = None
+    if gp is not None:
+        rm, ref_grid = gp
+        ref = np.zeros(3)
+        if ref_grid > 0 and xyz is not None and ref_grid in set(ids.tolist()):
+            ref = xyz[int(np.flatnonzero(ids == ref_grid)[0])]
+        elif ref_grid > 0:
+            rm = None  # reference grid unknown: do not guess its position
+    return Op2Modes(
+        path=f.path,
+        table=name,
+        sort=sort,
+        mode=modes,
+        eigenvalue=lama[sel, 2],
+        generalized_mass=lama[sel, 5],
+        grid_ids=ids,
+        shapes=shapes,
+        cd=cd,
+        xyz_basic=xyz,
+        coords=systems,
+        rigid_mass=rm,
+        rigid_mass_ref=ref,
+        params=params,
+        n_scalar=n_scalar,
+    )
+
+
+def _bdf_geometry(
+    bdf: str | Path, ids: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, dict[int, CoordSystem]]:
+    """Grid positions (basic), output systems and coordinate systems from a BDF deck.
+
+    Uses microg's own deck reader (:mod:`microg.models.bdf`) when it offers
+    ``grid_geometry``; otherwise pyNastran, if installed.
+    """
+    try:
+        from microg.models import bdf as mbdf  # the deck reader (another module's)
+
+        geom = getattr(mbdf, "grid_geometry", None)
+    except ImportError:
+        geom = None
+    if geom is not None:
+        xyz, cd, systems = geom(bdf, ids)
+        return np.asarray(xyz, float), np.asarray(cd, int), dict(systems)
+    try:
+        from pyNastran.bdf.bdf import read_bdf
+    except ImportError:
+        raise InputError(
+            "the OP2 has no geometry tables and no BDF reader is available",
+            where=str(bdf),
+            fix=f"{EXTRA_HINT}, or rerun NASTRAN with the geometry in the OP2 (PARAM,POST)",
+        ) from None
+    model = read_bdf(str(bdf), debug=None)
+    systems = {}
+    for cid, c in model.coords.items():
+        kind = c.Type
+        systems[int(cid)] = CoordSystem(
+            int(cid), kind, np.asarray(c.origin, float), np.asarray(c.beta(), float).T
+        )
+    xyz = np.array([model.nodes[int(g)].get_position() for g in ids])
+    cd = np.array([model.nodes[int(g)].cd for g in ids])
+    return xyz, cd, systems
+
+
+def modal_model_from_op2(
+    path: str | Path,
+    units: UnitSystem,
+    *,
+    points: Sequence[ModalPoint] = (),
+    bdf: str | Path | None = None,
+    rigid_mass: np.ndarray | None = None,
+    rigid_mass_ref_m: np.ndarray | None = None,
+    replace_rigid: bool = True,
+) -> ModalModel:
+    """A :class:`ModalModel` (SI, basic frame, mass-normalised) from a SOL 103 OP2.
+
+    Parameters
+    ----------
+    path : str or Path
+    units : UnitSystem
+        The run's units (``parse_units("in, lbf, s", wtmass=...)``).
+    points : sequence of ModalPoint
+        Named points (each grid must be in the file).
+    bdf : path, optional
+        Deck for the geometry when the OP2 has none (default: ``<stem>.bdf``/``.dat`` beside).
+    rigid_mass : ndarray (6, 6), optional
+        Rigid-body mass, SI, about ``rigid_mass_ref_m`` (default: the OP2's OGPWG, if any).
+    replace_rigid : bool
+        Replace free-free rigid modes by exact ones
+        (:func:`~microg.models.modal.replace_rigid_modes`).
+    """
+    op2 = read_op2_modes(path)
+    where = op2.path
+    wt_file = op2.params.get("WTMASS")
+    if wt_file is not None and units.wtmass != 1.0 and abs(units.wtmass - wt_file) > 1e-6 * wt_file:
+        raise InputError(
+            f"WTMASS {units.wtmass:g} declared, but the run used PARAM,WTMASS,{wt_file:g}",
+            where="wtmass",
+            fix="declare the run's WTMASS or omit it",
+        )
+    wtmass = float(wt_file) if wt_file is not None else units.wtmass
+    warnings: list[str] = []
+    xyz, cd = op2.xyz_basic, op2.cd
+    coords = dict(op2.coords)
+    if xyz is None:
+        deck = Path(bdf) if bdf is not None else None
+        if deck is None:
+            for suffix in (".bdf", ".dat"):
+                cand = Path(path).with_suffix(suffix)
+                if cand.is_file():
+                    deck = cand
+                    break
+        if deck is None:
+            raise InputError(
+                "the OP2 has no grid geometry (no GEOM1 or BGPDT table) and no BDF is beside it",
+                where=where,
+                fix="rerun with PARAM,POST,-1/-2 (geometry written), or put the deck beside it",
+            )
+        xyz, cd_bdf, coords = _bdf_geometry(deck, op2.grid_ids)
+        if not op2.table.startswith("B") and str(op2.params.get("OUGCORD", "")).upper() != "BASIC":
+            cd = cd_bdf
+    data = Op2Modes(**{**op2.__dict__, "xyz_basic": xyz, "cd": cd, "coords": coords})
+    shapes = data.shapes_basic()
+    gm = op2.generalized_mass.astype(float)
+    if np.any(gm <= 0) or not np.all(np.isfinite(gm)):
+        raise InputError("LAMA has a non-positive generalized mass", where=where)
+    L, M = units.length_m, units.mass_kg
+    phi = shapes / np.sqrt(gm)[None, None, :]
+    phi[:, :3] /= np.sqrt(M)
+    phi[:, 3:] /= np.sqrt(M) * L
+    freq = op2.freq_hz_signed / units.time_s
+    rm, ref = None, None
+    src = ""
+    if rigid_mass is not None:
+        rm, ref, src = np.asarray(rigid_mass, float), rigid_mass_ref_m, "given"
+    elif op2.rigid_mass is not None and op2.rigid_mass_ref is not None:
+        scale = np.ones((6, 6))
+        scale[:3, 3:] = L
+        scale[3:, :3] = L
+        scale[3:, 3:] = L * L
+        rm = op2.rigid_mass * wtmass * M * scale
+        ref = op2.rigid_mass_ref * L
+        src = "OGPWG"
+    if op2.n_scalar:
+        warnings.append(f"{op2.n_scalar} scalar points dropped (no position)")
+    for p in points:
+        if p.grid not in set(op2.grid_ids.tolist()):
+            near = ", ".join(f"grid:{v}" for v in nearest_ids(op2.grid_ids, p.grid))
+            raise InputError(
+                f"grid {p.grid} (point {p.name!r}) is not in the file",
+                where=where,
+                fix=f"nearest grids: {near}",
+            )
+    return build_modal_model(
+        name=Path(path).stem,
+        grid_ids=op2.grid_ids,
+        xyz_m=xyz * L,
+        freq_hz_signed=freq,
+        phi=phi,
+        units=UnitSystem(units.text, units.length_m, units.force_N, units.time_s, M, wtmass),
+        source=where,
+        generalized_mass_kg_m2=gm * M * L * L,
+        points=points,
+        rigid_mass=rm,
+        rigid_mass_ref_m=ref,
+        mass_source=src,
+        replace_rigid=replace_rigid,
+        warnings=warnings,
+        meta={"table": op2.table, "sort": op2.sort, "reader": "microg OP2"},
+    )
+
+
+# --------------------------------------------------------------------------- OP4
+
+
+@dataclass(frozen=True)
+class Op4Model:
+    """Matrices read from an OP4 file (file units).
+
+    Attributes
+    ----------
+    path : str
+    matrices : dict of str to ndarray
+        Name (upper case) -> dense matrix.
+    """
+
+    path: str
+    matrices: dict[str, np.ndarray]
+
+    def get(self, name: str) -> np.ndarray:
+        """The matrix ``name``; a missing one is an error listing those present."""
+        key = name.upper()
+        if key not in self.matrices:
+            raise InputError(
+                f"no matrix {name!r} in the file",
+                where=self.path,
+                fix=f"matrices present: {', '.join(sorted(self.matrices)) or 'none'}",
+            )
+        return self.matrices[key]
+
+
+def _first_line(exc: BaseException) -> str:
+    text = str(exc)
+    return text.splitlines()[0] if text else ""
+
+
+def read_op4(path: str | Path) -> Op4Model:
+    """Read every matrix of an OP4 (ASCII or binary) with pyyeti's reader (lazy import)."""
+    label = str(path)
+    if not Path(path).is_file():
+        raise InputError("no such file", where=label)
+    try:
+        from pyyeti.nastran import op4
+    except ImportError:
+        raise InputError("reading OP4 needs pyyeti", where=label, fix=EXTRA_HINT) from None
+    import warnings as _w
+
+    try:
+        with _w.catch_warnings():
+            _w.simplefilter("ignore")
+            mats = op4.read(label, into="dct", sparse=False)
+    except Exception as exc:  # pyyeti raises bare errors on corrupt files
+        raise InputError(
+            f"truncated or corrupt OP4: {type(exc).__name__}: {_first_line(exc)}",
+            where=label,
+        ) from None
+    out = {}
+    for k, v in mats.items():
+        arr = v[0] if isinstance(v, tuple) else v
+        out[str(k).upper()] = np.asarray(arr)
+    return Op4Model(label, out)
+
+
+def modal_model_from_op4(
+    path: str | Path,
+    units: UnitSystem,
+    *,
+    dof_map: np.ndarray,
+    xyz: np.ndarray,
+    grid_ids: np.ndarray,
+    mass: str = "MAA",
+    stiffness: str = "KAA",
+    shapes: str | None = None,
+    points: Sequence[ModalPoint] = (),
+    n_modes: int | None = None,
+) -> ModalModel:
+    """A :class:`ModalModel` from OP4 matrices: solve ``KAA phi = lambda MAA phi``, recover
+    grid motion through ``shapes`` (rows on ``dof_map``) or take the a-set itself.
+
+    Parameters
+    ----------
+    path : OP4 file
+    units : UnitSystem
+    dof_map : ndarray (n, 2) int
+        ``[grid, component 1..6]`` of each row of the recovery matrix (or of the a-set
+        when ``shapes`` is None).
+    xyz : ndarray (g, 3)
+        Basic positions of ``grid_ids`` (file length unit).
+    grid_ids : ndarray (g,)
+    mass, stiffness : str
+        Matrix names (a-set).
+    shapes : str, optional
+        Recovery matrix (rows: ``dof_map``; columns: a-set DOFs) -- e.g. a transformation
+        to the grids' DOFs.
+    n_modes : int, optional
+        Lowest modes kept.
+    """
+    import scipy.linalg as sla
+
+    op4m = read_op4(path)
+    maa = op4m.get(mass).astype(float)
+    kaa = op4m.get(stiffness).astype(float)
+    if maa.shape != kaa.shape or maa.shape[0] != maa.shape[1]:
+        raise InputError(f"{mass} and {stiffness} must be square of one size", where=op4m.path)
+    lam, vec = sla.eigh(0.5 * (kaa + kaa.T), 0.5 * (maa + maa.T))
+    if n_modes is not None:
+        lam, vec = lam[:n_modes], vec[:, :n_modes]
+    rec = op4m.get(shapes).astype(float) if shapes else np.eye(maa.shape[0])
+    if rec.shape[1] != maa.shape[0]:
+        raise InputError(
+            f"{shapes} has {rec.shape[1]} columns, the a-set {maa.shape[0]} DOFs", where=op4m.path
+        )
+    dof_map = np.asarray(dof_map, int)
+    if dof_map.shape != (rec.shape[0], 2):
+        raise InputError(f"the DOF map must have shape ({rec.shape[0]}, 2)", where="dof_map")
+    ids = np.asarray(grid_ids, np.int64)
+    pos = {int(g): i for i, g in enumerate(ids)}
+    g_shapes = np.zeros((ids.size, 6, lam.size))
+    rows = rec @ vec
+    for r, (gid, comp) in enumerate(dof_map):
+        if int(gid) not in pos:
+            raise InputError(f"DOF map row {r}: grid {gid} has no position", where="dof_map")
+        if not 1 <= comp <= 6:
+            raise InputError(f"DOF map row {r}: component {comp} is not 1..6", where="dof_map")
+        g_shapes[pos[int(gid)], comp - 1] = rows[r]
+    L, M = units.length_m, units.mass_kg
+    phi = g_shapes.copy()
+    phi[:, :3] /= np.sqrt(M)
+    phi[:, 3:] /= np.sqrt(M) * L
+    freq = np.sign(lam) * np.sqrt(np.abs(lam)) / (2 * np.pi) / units.time_s
+    # mass on the grids' DOFs when the a-set is the grid set (no recovery matrix)
+    mg = None
+    if shapes is None:
+        mg = np.zeros((6 * ids.size, 6 * ids.size))
+        idx = np.array([6 * pos[int(g)] + c - 1 for g, c in dof_map])
+        sc = np.where(dof_map[:, 1] <= 3, 1.0, L)
+        mg[np.ix_(idx, idx)] = maa * M * np.outer(sc, sc)
+    return build_modal_model(
+        name=Path(path).stem,
+        grid_ids=ids,
+        xyz_m=np.asarray(xyz, float) * L,
+        freq_hz_signed=freq,
+        phi=phi,
+        units=units,
+        source=op4m.path,
+        points=points,
+        mass_matrix=mg,
+        mass_source="MAA" if mg is not None else "",
+        meta={"reader": "pyyeti OP4", "mass": mass, "stiffness": stiffness, "shapes": shapes},
+    )
