@@ -1,0 +1,159 @@
+"""OP2 reader details (SORT2, bad files), OP4 models, units at the boundary, load_model."""
+
+from __future__ import annotations
+
+import struct
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from microg.dynamics.modes import solve_modes
+from microg.errors import InputError
+from microg.models.load import load_model
+from microg.models.nastran import Op2File, read_op2_modes
+from microg.models.toml import load_station
+from microg.structure.discretize import discretize
+
+DATA = Path(__file__).parent.parent / "data" / "nastran"
+BEAM = DATA / "beam_modes_m2.op2"
+
+
+def _write_op2(tables, path):
+    """Write OUTPUT2 records (32-bit little-endian): the layout Op2File reads."""
+    out = bytearray()
+
+    def rec(b):
+        out.extend(struct.pack("<i", len(b)) + b + struct.pack("<i", len(b)))
+
+    def key(v):
+        rec(struct.pack("<i", v))
+
+    for name, trailer, records in tables:
+        key(2)
+        rec(name.ljust(8).encode()[:8])
+        key(-1)
+        key(7)
+        rec(np.asarray(trailer, "<i4").tobytes())
+        key(-2)
+        key(1)
+        key(0)
+        for r, data in enumerate(records):
+            key(len(data) // 4)
+            rec(data)
+            key(-(r + 3))
+            key(1)
+            key(0)
+        key(0)
+    key(0)
+    path.write_bytes(bytes(out))
+    return path
+
+
+def _sort2_copy(tmp_path):
+    """The beam OP2 with its OUGV1 rewritten in SORT2 (one record pair per grid)."""
+    f = Op2File(BEAM)
+    tables = []
+    for name, trailer, recs in f.tables:
+        if name != "OUGV1":
+            tables.append((name, trailer, recs))
+            continue
+        pairs = [(recs[i], recs[i + 1]) for i in range(1, len(recs) - 1, 2)]
+        n = len(pairs[0][1]) // 32
+        data = np.stack([np.frombuffer(d, "<f4").reshape(n, 8) for _, d in pairs])  # (m, n, 8)
+        ints = np.frombuffer(pairs[0][1], "<i4").reshape(n, 8)
+        new = [recs[0]]
+        for gi in range(n):
+            ident = np.frombuffer(pairs[0][0], "<i4").copy()
+            ident[1] = 2007  # SORT2 real eigenvectors
+            ident[4] = ints[gi, 0]  # grid id * 10 + device code
+            rows = data[:, gi, :].copy()
+            rows_i = rows.view("<i4")
+            rows_i[:, 0] = np.arange(1, data.shape[0] + 1)  # mode numbers
+            rows_i[:, 1] = ints[gi, 1]
+            new += [ident.tobytes(), rows.tobytes()]
+        tables.append((name, trailer, new))
+    return _write_op2(tables, tmp_path / "sort2.op2")
+
+
+def test_sort2_equals_sort1(tmp_path):
+    s1 = read_op2_modes(BEAM)
+    s2 = read_op2_modes(_sort2_copy(tmp_path))
+    assert s1.sort == "SORT1" and s2.sort == "SORT2"
+    assert np.array_equal(s2.grid_ids, s1.grid_ids)
+    assert np.array_equal(s2.shapes, s1.shapes)  # same float32 values, other layout
+    assert np.array_equal(s2.eigenvalue, s1.eigenvalue)
+
+
+def test_op2_without_eigenvectors(tmp_path):
+    f = Op2File(BEAM)
+    bad = _write_op2([t for t in f.tables if t[0] != "OUGV1"], tmp_path / "noeig.op2")
+    with pytest.raises(InputError, match="no real eigenvectors") as exc:
+        read_op2_modes(bad)
+    assert exc.value.where == str(bad) and "\n" not in str(exc.value)
+
+
+@pytest.mark.parametrize("cut", [100, 20000, 60000])
+def test_truncated_op2(tmp_path, cut):
+    bad = tmp_path / "cut.op2"
+    bad.write_bytes(BEAM.read_bytes()[:cut])
+    with pytest.raises(InputError, match="truncated or corrupt") as exc:
+        read_op2_modes(bad)
+    assert exc.value.where == str(bad)
+
+
+def test_not_an_op2(tmp_path):
+    bad = tmp_path / "x.op2"
+    bad.write_bytes(b"hello world, not fortran records")
+    with pytest.raises(InputError, match="not an OP2"):
+        read_op2_modes(bad)
+
+
+def test_units_required_and_grid_not_in_file(tmp_path):
+    with pytest.raises(InputError, match="declare no units") as exc:
+        load_model(BEAM)
+    assert exc.value.where == str(BEAM)
+    pts = tmp_path / "p.toml"
+    pts.write_text('units = "in, lbf, s"\n[points]\nlab = "grid:40"\n')
+    with pytest.raises(
+        InputError, match=r"nearest grids: grid:8, grid:9, grid:10, grid:11, grid:12"
+    ):
+        load_model(BEAM, points=pts)
+    pts.write_text('units = "in, kg, s"\n')
+    with pytest.raises(InputError, match="cannot be derived"):
+        load_model(BEAM, points=pts)
+
+
+def test_units_conversion_of_the_beam(tmp_path):
+    a = load_model(BEAM, units="in, lbf, s")
+    b = load_model(BEAM, units="m, N, s")
+    # same numbers read as inches: positions scale by 0.0254, frequencies do not change,
+    # mass-normalised translations by 1/sqrt(slinch/kg) (module docstring of modal.py)
+    assert np.allclose(a.xyz_m, 0.0254 * b.xyz_m)
+    assert np.allclose(a.omega, b.omega)
+    assert np.allclose(a.phi[:, :3], b.phi[:, :3] / np.sqrt(175.12683524647636))
+    assert np.allclose(a.phi[:, 3:], b.phi[:, 3:] / np.sqrt(175.12683524647636) / 0.0254)
+
+
+def test_op4_model_from_maa_kaa(tmp_path):
+    """MAA/KAA of microg's own FE model of IOC written by pyyeti, read back and solved."""
+    pytest.importorskip("pyyeti")
+    from pyyeti.nastran import op4
+
+    s = discretize(load_station("ioc-no-orbiter"))
+    m, k = s.dense()
+    n = m.shape[0] // 6
+    op4.write(str(tmp_path / "ioc.op4"), {"MAA": m, "KAA": k})
+    pos = np.asarray(s.meta["node_positions"])
+    rows = [(g + 1, c, *pos[g]) for g in range(n) for c in range(1, 7)]
+    np.savetxt(tmp_path / "ioc.dofmap.csv", rows, delimiter=",", fmt="%d,%d,%.17g,%.17g,%.17g")
+    mm = load_model(tmp_path / "ioc.op4", units="m, N, s")
+    ref = solve_modes(s)
+    r = mm.replaced_rigid
+    assert r.count == 6 and r.mass_source == "MAA"
+    # reference: microg's exact free-free solve of the same matrices (dense, rigid exact)
+    el = ~ref.rigid
+    ne = int(el.sum())
+    assert np.allclose(mm.omega[6 : 6 + ne], ref.omega[el], rtol=1e-7)
+    st = mm.to_structure(samples=False)
+    assert st.total_mass == pytest.approx(s.total_mass, rel=1e-10)
