@@ -91,7 +91,8 @@ def main() -> None:
         modal_model_from_uff(u)
         tr = time.perf_counter() - t0
         print(
-            f"UFF ({g_uff} grids, {u.stat().st_size / 1e6:.0f} MB): write {tw:.2f} s, read {tr:.2f} s"
+            f"UFF ({g_uff} grids, {u.stat().st_size / 1e6:.0f} MB): "
+            f"write {tw:.2f} s, read {tr:.2f} s"
         )
 
 
