@@ -21,13 +21,20 @@ a jump of p), ``j_k = s_k - 2 zeta omega a_k - omega^2 v_k``, and the four funct
 
 ``sigma = zeta omega``, ``omega_d = omega sqrt(1 - zeta^2)``.  ``g`` and ``h`` are written with
 ``sinc`` so they are exact for ``omega -> 0``; ``S`` and ``R`` lose digits by cancellation when
-``omega tau`` is small, so for ``omega tau < 1`` they are summed from their Taylor series (the
+``omega tau`` is small, so for ``omega tau < 0.5`` they are summed from their Taylor series (the
 recursion of the ODE itself).  A rigid-body mode (``omega = 0``) therefore needs no special case:
 it is double integration, ``S = tau^2/2``, ``R = tau^3/6``.
 
-The start states of all segments are the prefix composition of the segments' affine state maps,
-done by a log-depth (Hillis-Steele) scan vectorised over modes and segments; the output times are
-located with ``np.searchsorted`` and evaluated at once, vectorised over modes and times.
+The start states of all segments are the chain of the segments' affine state maps, computed by
+the one blocked O(K) scan :func:`microg._scan.affine_scan`, vectorised over modes.  The output
+times are then split into uniformly spaced runs inside one segment, each evaluated by two small
+tables of exact exponentials and one batched matrix product (:func:`_table_run`), and the rest,
+evaluated directly by the closed form.  :func:`response_at_points` contracts the modes with
+``T phi`` block by block, never building the (3, modes, times) array.
+
+Exact peaks (:func:`peak_response`): the supremum of |a(t)| and of each axis over a window,
+including both one-sided limits at the force's jumps and the stationary points between samples,
+with a certified upper bound (see the function).
 
 Conventions: the force is zero before the first breakpoint; a repeated breakpoint time is a jump
 (the last value at that time holds from it on, i.e. the force is right-continuous; times closer than
@@ -37,12 +44,13 @@ value.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
 
+from microg._scan import affine_scan
 from microg.errors import InputError
 from microg.units import G0
 
@@ -51,11 +59,14 @@ if TYPE_CHECKING:
 
 __all__ = [
     "ModalResponse",
+    "PeakResponse",
     "PointResponse",
-    "modal_pwl_response",
+    "combined_modal_force",
     "generalized_force_vector",
-    "response_at_points",
+    "modal_pwl_response",
     "oscillator_functions",
+    "peak_response",
+    "response_at_points",
 ]
 
 #: below this value of omega * tau the step and ramp functions are summed from their series
@@ -253,166 +264,297 @@ def _start_states(
 ) -> tuple[np.ndarray, np.ndarray]:
     """States (eta, eta') at the start of every segment, zero at the first breakpoint.
 
-    Segment k maps its start state z_k to z_{k+1} = M_k z_k + c_k.  The inclusive prefix
-    composition of these affine maps (log-depth scan over segments, vectorised over modes) applied
-    to z_0 = 0 gives z_{k+1} = C_k, the accumulated offset.
+    Segment k maps its start state z_k to z_{k+1} = M_k z_k + c_k; the chain of these affine
+    maps is :func:`microg._scan.affine_scan` (vectorised over modes).
     """
     m, K = p_right.shape
-    eta0 = np.zeros((m, K))
-    vel0 = np.zeros((m, K))
     if K == 1:
-        return eta0, vel0
+        return np.zeros((m, 1)), np.zeros((m, 1))
     w = omega[:, None]
     z = zeta[:, None]
     tau = lengths[None, :]
     g, h, S, R = oscillator_functions(w, z, tau)
+    assert R is not None
     p = p_right[:, :-1]
     s = slopes[:, :-1]
-    # state map of one segment: [eta, v] -> [[g, h], [-w^2 h, g']] [eta, v] + c
-    # with g' for velocity: v(tau) = v0 g + a0 h + s S and a0 = p - 2 sigma v0 - w^2 eta0
-    two_sigma = 2.0 * z * w
-    w2 = w * w
-    m00, m01 = g, h
-    m10 = -w2 * h
-    m11 = g - two_sigma * h
-    c0 = p * S + s * R
-    c1 = p * h + s * S
-    # Hillis-Steele inclusive scan: (M, c)_k <- (M, c)_k o (M, c)_{k-d}
-    d = 1
-    n = K - 1
-    while d < n:
-        a00, a01, a10, a11 = m00[:, d:], m01[:, d:], m10[:, d:], m11[:, d:]
-        b00, b01, b10, b11 = m00[:, :-d], m01[:, :-d], m10[:, :-d], m11[:, :-d]
-        bc0, bc1 = c0[:, :-d], c1[:, :-d]
-        new_c0 = a00 * bc0 + a01 * bc1 + c0[:, d:]
-        new_c1 = a10 * bc0 + a11 * bc1 + c1[:, d:]
-        new00 = a00 * b00 + a01 * b10
-        new01 = a00 * b01 + a01 * b11
-        new10 = a10 * b00 + a11 * b10
-        new11 = a10 * b01 + a11 * b11
-        c0 = np.concatenate([c0[:, :d], new_c0], axis=1)
-        c1 = np.concatenate([c1[:, :d], new_c1], axis=1)
-        m00 = np.concatenate([m00[:, :d], new00], axis=1)
-        m01 = np.concatenate([m01[:, :d], new01], axis=1)
-        m10 = np.concatenate([m10[:, :d], new10], axis=1)
-        m11 = np.concatenate([m11[:, :d], new11], axis=1)
-        d *= 2
-    eta0[:, 1:] = c0
-    vel0[:, 1:] = c1
-    return eta0, vel0
+    # state map of one segment: [eta, v] -> [[g, h], [-w^2 h, g - 2 sigma h]] [eta, v] + c
+    # (v(tau) = v0 g + a0 h + s S with a0 = p - 2 sigma v0 - w^2 eta0)
+    maps = np.empty((m, K - 1, 2, 2))
+    maps[..., 0, 0] = g
+    maps[..., 0, 1] = h
+    maps[..., 1, 0] = -(w * w) * h
+    maps[..., 1, 1] = g - 2.0 * z * w * h
+    offsets = np.stack([p * S + s * R, p * h + s * S], axis=-1)
+    states = affine_scan(maps, offsets)  # (m, K, 2)
+    return states[..., 0], states[..., 1]
 
 
-def _uniform_split(tau: np.ndarray) -> tuple[float, int, int] | None:
-    """(dt, L, nblocks), nblocks * L <= n, if ``tau`` is uniform to a few roundings; else None."""
-    n = tau.size
-    if n < 64:
-        return None
-    dt = (tau[-1] - tau[0]) / (n - 1)
-    if not dt > 0:
-        return None
-    dev = np.max(np.abs(tau - (tau[0] + np.arange(n) * dt)))
-    if dev > 8.0 * np.spacing(np.max(np.abs(tau)) + abs(tau[0])):
-        return None
-    L = int(np.ceil(np.sqrt(n)))
-    return dt, L, n // L
+@dataclass(frozen=True)
+class _State:
+    """Modal state at the start of every force segment (private).
 
-
-def _elastic_segment(
-    omega: np.ndarray,
-    zeta: np.ndarray,
-    eta0: np.ndarray,
-    vel0: np.ndarray,
-    acc0: np.ndarray,
-    jerk0: np.ndarray,
-    p0: np.ndarray,
-    s0: np.ndarray,
-    tau: np.ndarray,
-    out: np.ndarray,
-) -> None:
-    """Response of elastic modes (omega > 0) on one segment at elapsed times ``tau`` (sorted).
-
-    Writes eta, eta', eta'' into ``out`` (a view of shape (3, m, n)).  With E = exp(lambda tau),
-    lambda = -sigma + i omega_d, each quantity is ``Re E * cc + Im E * cs + q0 + q1 tau`` with
-    per-mode coefficients folding in the start state and the force.  On a uniform run of ``tau``
-    E_i = exp(lambda tau_b) exp(lambda r dt) (i = b L + r): two small tables of direct
-    evaluations, and the whole (3, m, n) block is one batched matrix product with inner
-    dimension 4 -- a few roundings per entry, no recurrence.  Otherwise E is evaluated directly.
-    Where omega tau < _SERIES_BELOW (a prefix of ``tau`` for each mode) the folded form loses
-    digits by cancellation; those entries are recomputed with :func:`oscillator_functions`.
+    ``starts`` (K,) s; the others (m, K): eta, eta', eta'' (right-continuous), eta''' and the
+    force value p and slope s on the segment.
     """
+
+    omega: np.ndarray
+    zeta: np.ndarray
+    starts: np.ndarray
+    eta: np.ndarray
+    vel: np.ndarray
+    acc: np.ndarray
+    jerk: np.ndarray
+    p: np.ndarray
+    s: np.ndarray
+
+    @property
+    def rigid(self) -> np.ndarray:
+        return np.flatnonzero(self.omega == 0)
+
+    @property
+    def elastic(self) -> np.ndarray:
+        return np.flatnonzero(self.omega != 0)
+
+
+def _prepare(
+    omega: np.ndarray, zeta: np.ndarray, timepts_force: np.ndarray, modal_force: np.ndarray
+) -> _State:
+    starts, p_right, slopes, lengths = _segments(timepts_force, modal_force)
+    eta_k, vel_k = _start_states(omega, zeta, p_right, slopes, lengths)
+    w = omega[:, None]
+    two_sigma = 2.0 * zeta[:, None] * w
+    w2 = w * w
+    acc_k = p_right - two_sigma * vel_k - w2 * eta_k
+    jerk_k = slopes - two_sigma * acc_k - w2 * vel_k
+    return _State(omega, zeta, starts, eta_k, vel_k, acc_k, jerk_k, p_right, slopes)
+
+
+def _as_arrays(
+    omega: np.ndarray,
+    zeta: np.ndarray | float,
+    timepts_force: np.ndarray,
+    modal_force: np.ndarray,
+    timepts_out: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    omega = np.asarray(omega, dtype=float)
+    zeta = np.broadcast_to(np.asarray(zeta, dtype=float), omega.shape).astype(float)
+    timepts_force = np.asarray(timepts_force, dtype=float)
+    modal_force = np.asarray(modal_force, dtype=float)
+    if modal_force.ndim == 1 and omega.size == 1:
+        modal_force = modal_force[None, :]
+    timepts_out = np.asarray(timepts_out, dtype=float)
+    _validate(omega, zeta, timepts_force, modal_force, timepts_out)
+    return omega, zeta, timepts_force, modal_force, timepts_out
+
+
+# --------------------------------------------------------------------------- evaluation
+
+#: uniform runs of at least this many output times (inside one segment) use the table path
+_MIN_RUN = 64
+#: output times per evaluation block when projecting onto points (bounds the scratch memory)
+_CHUNK = 4096
+
+
+def _runs(t: np.ndarray, starts: np.ndarray) -> tuple[list[tuple[int, int, int]], np.ndarray]:
+    """Uniform runs ``(segment, i0, i1)`` of the output times and the indices of the others.
+
+    A run is a maximal set of consecutive output times inside one force segment with equal
+    spacing (to a few roundings of the largest time, and within that of ``t0 + i dt``); runs
+    shorter than :data:`_MIN_RUN` and irregular times are returned as indices for the direct
+    (gathered) evaluation.  Times before the first breakpoint are in neither (zero response).
+    """
+    nt = t.size
+    seg = np.searchsorted(starts, t, side="right") - 1
+    tol = 8.0 * np.spacing(max(float(np.max(np.abs(t))) if nt else 0.0, 1.0))
+    runs: list[tuple[int, int, int]] = []
+    covered = np.zeros(nt + 1, dtype=np.int64)
+    if nt >= 2:
+        d = np.diff(t)
+        valid = (seg[1:] == seg[:-1]) & (seg[1:] >= 0)  # diff j joins points j, j+1
+        same = np.r_[False, np.abs(np.diff(d)) <= tol] & np.r_[False, valid[:-1]]
+        first = valid & ~same  # a diff that starts a new run
+        j0 = np.flatnonzero(first)
+        if j0.size:
+            run_id = np.cumsum(first) - 1
+            j_last = np.flatnonzero(valid)
+            # last valid diff of each run
+            ends = np.zeros(j0.size, dtype=np.intp)
+            np.maximum.at(ends, run_id[j_last], j_last)
+            p1 = ends + 1  # last point of each run (inclusive)
+            p0 = np.maximum(j0, np.r_[-1, p1[:-1]] + 1)  # a shared point goes to the earlier run
+            long = np.flatnonzero(p1 - p0 + 1 >= _MIN_RUN)
+            for r in long:
+                i0, i1 = int(p0[r]), int(p1[r]) + 1
+                tt = t[i0:i1]
+                n = i1 - i0
+                dt = (tt[-1] - tt[0]) / (n - 1)
+                if np.max(np.abs(tt - (tt[0] + np.arange(n) * dt))) > tol:
+                    continue  # a slowly drifting spacing: not uniform, evaluate directly
+                runs.append((int(seg[i0]), i0, i1))
+                covered[i0] += 1
+                covered[i1] -= 1
+    mask = (np.cumsum(covered[:nt]) == 0) & (seg >= 0)
+    return runs, np.flatnonzero(mask)
+
+
+def _table_run(st: _State, k: int, tau: np.ndarray, qs: tuple[int, ...], dest: np.ndarray) -> None:
+    """Quantities ``qs`` (0 eta, 1 eta', 2 eta'') of all modes on a uniform run of segment k.
+
+    Writes ``dest`` (len(qs), m, n).  Elastic modes: with E = exp(lambda tau), lambda =
+    -sigma + i omega_d, each quantity is ``Re E * cc + Im E * cs + q0 + q1 tau`` with per-mode
+    coefficients folding in the start state and the force.  On the run tau_i = tau_0 + i dt,
+    with i = b L + r, E_i = exp(lambda (tau_0 + b L dt)) exp(lambda r dt): two small tables of
+    direct evaluations, and the whole block is one batched matrix product with inner dimension 4
+    (a few roundings per entry, no recurrence).  Where omega tau < _SERIES_BELOW (a prefix of the
+    run for each mode) the folded eta and eta' lose digits by cancellation; those entries are
+    recomputed with :func:`oscillator_functions` (eta'' has no cancellation).  Rigid modes are
+    the exact polynomials of a double integration.
+    """
+    n = tau.size
+    nq = len(qs)
+    e0, v0, a0, j0, p0, s0 = (x[:, k] for x in (st.eta, st.vel, st.acc, st.jerk, st.p, st.s))
+    rigid, el = st.rigid, st.elastic
+    if rigid.size:
+        polys = {
+            0: (e0[rigid], v0[rigid], p0[rigid] / 2.0, s0[rigid] / 6.0),
+            1: (v0[rigid], p0[rigid], s0[rigid] / 2.0, np.zeros(rigid.size)),
+            2: (p0[rigid], s0[rigid], np.zeros(rigid.size), np.zeros(rigid.size)),
+        }
+        powers = np.stack([np.ones(n), tau, tau * tau, tau * tau * tau])  # (4, n)
+        for iq, q in enumerate(qs):
+            coef = np.stack(polys[q], axis=1)  # (r, 4)
+            dest[iq, rigid] = coef @ powers
+    if not el.size:
+        return
+    omega, zeta = st.omega[el], st.zeta[el]
+    e0, v0, a0, j0, p0, s0 = e0[el], v0[el], a0[el], j0[el], p0[el], s0[el]
     sigma = zeta * omega
     omega_d = omega * np.sqrt(1.0 - zeta * zeta)
     w2 = omega * omega
     beta = s0 / w2
-    g_coef = eta0 - p0 / w2 + 2.0 * sigma * s0 / (w2 * w2)
-    h_coef = vel0 - beta
     alpha = p0 / w2 - 2.0 * sigma * s0 / (w2 * w2)
     zero = np.zeros_like(omega)
-    cc = np.stack([g_coef, h_coef, acc0])  # (3, m): coefficient of Re E
-    cs = (sigma * cc + np.stack([h_coef, acc0, jerk0])) / omega_d  # coefficient of Im E
-    q0 = np.stack([alpha, beta, zero])
-    q1 = np.stack([beta, zero, zero])
+    cc_all = (e0 - alpha, v0 - beta, a0)  # coefficient of Re E
+    nxt = (v0 - beta, a0, j0)
+    cc = np.stack([cc_all[q] for q in qs])  # (nq, me)
+    cs = (sigma * cc + np.stack([nxt[q] for q in qs])) / omega_d  # coefficient of Im E
+    q0 = np.stack([(alpha, beta, zero)[q] for q in qs])
+    q1 = np.stack([(beta, zero, zero)[q] for q in qs])
     lam = (-sigma + 1j * omega_d)[:, None]
-    n = tau.size
-    split = _uniform_split(tau)
-    done = 0
-    if split is not None:
-        dt, L, nblocks = split
-        done = nblocks * L
-        tau_b = tau[0] + (np.arange(nblocks) * L) * dt
-        A = np.exp(lam * tau_b[None, :])  # (m, nblocks)
-        W = np.exp(lam * (np.arange(L) * dt)[None, :])  # (m, L)
-        Ar, Ai = A.real[None], A.imag[None]
-        c_, s_ = cc[:, :, None], cs[:, :, None]
-        lhs = np.stack(
-            [
-                c_ * Ar + s_ * Ai,
-                s_ * Ar - c_ * Ai,
-                q0[:, :, None] + q1[:, :, None] * tau_b[None, None, :],
-                np.broadcast_to(q1[:, :, None], (3, omega.size, nblocks)),
-            ],
-            axis=-1,
-        )  # (3, m, nblocks, 4)
-        rhs = np.stack(
-            [W.real, W.imag, np.ones_like(W.real), np.broadcast_to(np.arange(L) * dt, W.shape)],
-            axis=1,
-        )  # (m, 4, L)
-        target = out[:, :, :done].reshape(3, omega.size, nblocks, L)
-        if np.shares_memory(target, out):
-            np.matmul(lhs, rhs, out=target)
-        else:  # pragma: no cover - reshape of a last-axis slice is always a view
-            out[:, :, :done] = (lhs @ rhs).reshape(3, omega.size, done)
-    if done < n:
-        rest = tau[done:]
-        E = np.exp(lam * rest[None, :])
-        c, s = E.real, E.imag
-        for q in range(3):
-            out[q, :, done:] = (
-                c * cc[q, :, None] + s * cs[q, :, None] + q0[q, :, None] + q1[q, :, None] * rest
+    me = el.size
+    dt = (tau[-1] - tau[0]) / (n - 1) if n > 1 else 0.0
+    L = max(1, int(np.ceil(np.sqrt(n))))
+    nb = -(-n // L)
+    tau_b = tau[0] + (np.arange(nb) * L) * dt
+    A = np.exp(lam * tau_b[None, :])  # (me, nb)
+    rdt = np.arange(L) * dt
+    W = np.exp(lam * rdt[None, :])  # (me, L)
+    c_, s_ = cc[:, :, None], cs[:, :, None]
+    lhs = np.stack(
+        [
+            c_ * A.real + s_ * A.imag,
+            s_ * A.real - c_ * A.imag,
+            q0[:, :, None] + q1[:, :, None] * tau_b,
+            np.broadcast_to(q1[:, :, None], (nq, me, nb)),
+        ],
+        axis=-1,
+    )  # (nq, me, nb, 4)
+    rhs = np.stack(
+        [W.real, W.imag, np.ones_like(W.real), np.broadcast_to(rdt, W.shape)], axis=1
+    )  # (me, 4, L)
+    full_blocks = n // L
+    contiguous = el[-1] - el[0] + 1 == me
+    rows = slice(int(el[0]), int(el[-1]) + 1) if contiguous else el
+    target = dest[:, rows] if contiguous else np.empty((nq, me, n))
+    if full_blocks:
+        body = target[:, :, : full_blocks * L].reshape(nq, me, full_blocks, L)
+        if np.shares_memory(body, target):
+            np.matmul(lhs[:, :, :full_blocks], rhs, out=body)
+        else:  # pragma: no cover - a reshape of a last-axis slice is a view
+            target[:, :, : full_blocks * L] = (lhs[:, :, :full_blocks] @ rhs).reshape(nq, me, -1)
+    rem = n - full_blocks * L
+    if rem:
+        target[:, :, full_blocks * L :] = (lhs[:, :, -1, None, :] @ rhs[:, :, :rem])[:, :, 0]
+    # stable recomputation of eta, eta' where omega tau < _SERIES_BELOW
+    fix = [iq for iq, q in enumerate(qs) if q < 2]
+    if fix:
+        n_small = np.searchsorted(tau, _SERIES_BELOW / omega, side="left")
+        nmax = int(n_small.max(initial=0))
+        if nmax:
+            sel = np.flatnonzero(n_small)
+            tt = tau[None, :nmax]
+            g, h, S, R = oscillator_functions(omega[sel, None], zeta[sel, None], tt)
+            assert R is not None
+            mask = np.arange(nmax)[None, :] < n_small[sel, None]
+            ee, vv, aa = e0[sel, None], v0[sel, None], a0[sel, None]
+            stable = (
+                ee * g + vv * h + p0[sel, None] * S + s0[sel, None] * R,
+                vv * g + aa * h + s0[sel, None] * S,
             )
-    # stable recomputation where omega tau < _SERIES_BELOW (a prefix of tau for each mode)
-    n_small = np.searchsorted(tau, _SERIES_BELOW / omega, side="left")
-    nmax = int(n_small.max(initial=0))
-    if nmax:
-        rows = np.flatnonzero(n_small)
-        tt = tau[None, :nmax]
-        w, z = omega[rows, None], zeta[rows, None]
-        g, h, S, R = oscillator_functions(w, z, tt)
-        mask = np.arange(nmax)[None, :] < n_small[rows, None]
-        e0, v0, a0 = eta0[rows, None], vel0[rows, None], acc0[rows, None]
-        stable = (
-            e0 * g + v0 * h + p0[rows, None] * S + s0[rows, None] * R,
-            v0 * g + a0 * h + s0[rows, None] * S,
-            a0 * g + jerk0[rows, None] * h,
-        )
-        sub = np.ix_(rows, np.arange(nmax))
-        for q in range(3):
-            view = out[q]
-            view[sub] = np.where(mask, stable[q], view[sub])
+            sub = np.ix_(sel, np.arange(nmax))
+            for iq in fix:
+                view = target[iq]
+                view[sub] = np.where(mask, stable[qs[iq]], view[sub])
+    if not contiguous:
+        dest[:, el] = target
 
 
-#: above this many segments holding output times, evaluate all outputs at once (gather path)
-_MAX_SLICED_SEGMENTS = 64
+def _direct(st: _State, seg: np.ndarray, tau: np.ndarray, qs: tuple[int, ...]) -> np.ndarray:
+    """Quantities ``qs`` of all modes at elapsed times ``tau`` into segments ``seg`` (>= 0).
+
+    The closed form of the module docstring evaluated directly, shape (len(qs), m, n).
+    """
+    w, z = st.omega[:, None], st.zeta[:, None]
+    g, h, S, R = oscillator_functions(w, z, tau[None, :], need_ramp=0 in qs)
+    out = np.empty((len(qs), st.omega.size, tau.size))
+    for iq, q in enumerate(qs):
+        if q == 0:
+            assert R is not None
+            out[iq] = st.eta[:, seg] * g + st.vel[:, seg] * h + st.p[:, seg] * S + st.s[:, seg] * R
+        elif q == 1:
+            out[iq] = st.vel[:, seg] * g + st.acc[:, seg] * h + st.s[:, seg] * S
+        else:
+            out[iq] = st.acc[:, seg] * g + st.jerk[:, seg] * h
+    return out
+
+
+def _evaluate(
+    st: _State, t: np.ndarray, qs: tuple[int, ...], project: np.ndarray | None = None
+) -> np.ndarray:
+    """Quantities ``qs`` at the output times ``t``: (len(qs), m, nt), or projected (len(qs), r, nt).
+
+    ``project`` (r, m) contracts the modes block by block (at most :data:`_CHUNK` times at a
+    time), so the (len(qs), m, nt) modal array is never built.  Uniform runs take the table path
+    (:func:`_table_run`), everything else the direct closed form; zero before the first
+    breakpoint.
+    """
+    m, nt, nq = st.omega.size, t.size, len(qs)
+    rows = m if project is None else project.shape[0]
+    out = np.zeros((nq, rows, nt))
+    runs, rest = _runs(t, st.starts)
+    scratch = None if project is None else np.empty((nq, m, min(_CHUNK, max(nt, 1))))
+    for k, i0, i1 in runs:
+        if project is None:
+            _table_run(st, k, t[i0:i1] - st.starts[k], qs, out[:, :, i0:i1])
+            continue
+        assert scratch is not None
+        for c0 in range(i0, i1, _CHUNK):
+            c1 = min(c0 + _CHUNK, i1)
+            buf = scratch[:, :, : c1 - c0]
+            _table_run(st, k, t[c0:c1] - st.starts[k], qs, buf)
+            for iq in range(nq):  # 2-D products (BLAS), then one copy into the strided output
+                out[iq, :, c0:c1] = project @ buf[iq]
+    seg_all = np.searchsorted(st.starts, t, side="right") - 1
+    for c0 in range(0, rest.size, _CHUNK):
+        idx = rest[c0 : c0 + _CHUNK]
+        seg = seg_all[idx]
+        vals = _direct(st, seg, t[idx] - st.starts[seg], qs)
+        if project is None:
+            out[:, :, idx] = vals
+        else:
+            for iq in range(nq):
+                out[iq][:, idx] = project @ vals[iq]
+    return out
 
 
 def modal_pwl_response(
@@ -437,100 +579,21 @@ def modal_pwl_response(
     modal_force : (m, nb) modal force p at each breakpoint, already divided by the modal mass
         (N/kg-like units, m/s^2 per unit modal coordinate); at a repeated time the first column is
         the value just before the jump, the last the value from the jump on
-    timepts_out : (nt,) sorted output times, s; any spacing; times before the first breakpoint
-        give zero response
+    timepts_out : (nt,) sorted output times, s; any spacing (each uniformly spaced run inside a
+        force segment takes the fast table path); times before the first breakpoint give zero
+        response
 
     Returns
     -------
     ModalResponse
         ``eta``, ``eta_dot``, ``eta_ddot`` of shape (m, nt); accelerations are right-continuous.
     """
-    omega = np.asarray(omega, dtype=float)
-    zeta = np.broadcast_to(np.asarray(zeta, dtype=float), omega.shape).astype(float)
-    timepts_force = np.asarray(timepts_force, dtype=float)
-    modal_force = np.asarray(modal_force, dtype=float)
-    if modal_force.ndim == 1 and omega.size == 1:
-        modal_force = modal_force[None, :]
-    timepts_out = np.asarray(timepts_out, dtype=float)
-    _validate(omega, zeta, timepts_force, modal_force, timepts_out)
-
-    starts, p_right, slopes, lengths = _segments(timepts_force, modal_force)
-    eta_k, vel_k = _start_states(omega, zeta, p_right, slopes, lengths)
-    w = omega[:, None]
-    two_sigma = 2.0 * zeta[:, None] * w
-    w2 = w * w
-    acc_k = p_right - two_sigma * vel_k - w2 * eta_k
-    jerk_k = slopes - two_sigma * acc_k - w2 * vel_k
-    state = (eta_k, vel_k, acc_k, jerk_k, p_right, slopes)
-
-    bounds = np.r_[np.searchsorted(timepts_out, starts, side="left"), timepts_out.size]
-    filled = np.flatnonzero(np.diff(bounds) > 0)
-    if filled.size > _MAX_SLICED_SEGMENTS:
-        eta, eta_dot, eta_ddot = _evaluate_gathered(omega, zeta, starts, state, timepts_out)
-    else:
-        m, nt = omega.size, timepts_out.size
-        full = np.zeros((3, m, nt))
-        rigid = np.flatnonzero(omega == 0)
-        elastic = np.flatnonzero(omega != 0)
-        contiguous = elastic.size > 0 and elastic[-1] - elastic[0] + 1 == elastic.size
-        el_rows = slice(elastic[0], elastic[-1] + 1) if contiguous else elastic
-        out_e = full[:, el_rows] if contiguous else np.zeros((3, elastic.size, nt))
-        for k in filled:
-            i0, i1 = bounds[k], bounds[k + 1]
-            tau = timepts_out[i0:i1] - starts[k]
-            e0, v0, a0, j0, p0, s0 = (x[:, k] for x in state)
-            if rigid.size:  # double integration of a linear force: exact polynomials
-                r = rigid
-                t1, t2, t3 = tau, tau * tau / 2.0, tau**3 / 6.0
-                full[0, r, i0:i1] = (
-                    e0[r, None] + np.outer(v0[r], t1) + np.outer(p0[r], t2) + np.outer(s0[r], t3)
-                )
-                full[1, r, i0:i1] = v0[r, None] + np.outer(p0[r], t1) + np.outer(s0[r], t2)
-                full[2, r, i0:i1] = p0[r, None] + np.outer(s0[r], t1)
-            if elastic.size:
-                el = el_rows
-                _elastic_segment(
-                    omega[el],
-                    zeta[el],
-                    e0[el],
-                    v0[el],
-                    a0[el],
-                    j0[el],
-                    p0[el],
-                    s0[el],
-                    tau,
-                    out_e[:, :, i0:i1],
-                )
-        if elastic.size and not contiguous:
-            full[:, elastic] = out_e
-        eta, eta_dot, eta_ddot = full
+    omega, zeta, timepts_force, modal_force, timepts_out = _as_arrays(
+        omega, zeta, timepts_force, modal_force, timepts_out
+    )
+    st = _prepare(omega, zeta, timepts_force, modal_force)
+    eta, eta_dot, eta_ddot = _evaluate(st, timepts_out, (0, 1, 2))
     return ModalResponse(timepts=timepts_out, eta=eta, eta_dot=eta_dot, eta_ddot=eta_ddot)
-
-
-def _evaluate_gathered(
-    omega: np.ndarray,
-    zeta: np.ndarray,
-    starts: np.ndarray,
-    state: tuple[np.ndarray, ...],
-    timepts_out: np.ndarray,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Evaluate every output at once: locate its segment, gather the start state, closed form."""
-    eta_k, vel_k, acc_k, jerk_k, p_right, slopes = state
-    seg = np.searchsorted(starts, timepts_out, side="right") - 1
-    before = seg < 0
-    seg_c = np.where(before, 0, seg)
-    tau = np.where(before, 0.0, timepts_out - starts[seg_c])[None, :]
-    g, h, S, R = oscillator_functions(omega[:, None], zeta[:, None], tau)
-    e0, v0, a0 = eta_k[:, seg_c], vel_k[:, seg_c], acc_k[:, seg_c]
-    p0, s0, j0 = p_right[:, seg_c], slopes[:, seg_c], jerk_k[:, seg_c]
-    eta = e0 * g + v0 * h + p0 * S + s0 * R
-    eta_dot = v0 * g + a0 * h + s0 * S
-    eta_ddot = a0 * g + j0 * h
-    if np.any(before):
-        eta[:, before] = 0.0
-        eta_dot[:, before] = 0.0
-        eta_ddot[:, before] = 0.0
-    return eta, eta_dot, eta_ddot
 
 
 def generalized_force_vector(translation_map: np.ndarray, direction: np.ndarray) -> np.ndarray:
@@ -553,6 +616,31 @@ def generalized_force_vector(translation_map: np.ndarray, direction: np.ndarray)
     return np.asarray(translation_map, dtype=float).T @ (d / norm)
 
 
+def _point_projection(
+    phi: np.ndarray, point_maps: Mapping[str, np.ndarray], where: str
+) -> tuple[list[str], np.ndarray]:
+    """Names and the stacked (3 P, m) projection ``T_point phi`` of every point."""
+    names = list(point_maps)
+    blocks = []
+    for name in names:
+        tmap = np.asarray(point_maps[name], dtype=float)
+        if tmap.shape != (3, phi.shape[0]):
+            raise InputError(
+                f"translation map must have shape (3, {phi.shape[0]}), got {tmap.shape}",
+                where=f"{where}: point {name!r}",
+            )
+        blocks.append(tmap @ phi)
+    proj = np.concatenate(blocks) if blocks else np.zeros((0, phi.shape[1]))
+    return names, proj
+
+
+def _check_phi(phi: np.ndarray, omega: np.ndarray, b: np.ndarray, where: str) -> None:
+    if phi.ndim != 2 or phi.shape[1] != omega.size:
+        raise InputError(f"phi must have shape (n, {omega.size})", where=f"{where}: phi")
+    if b.shape != (phi.shape[0],):
+        raise InputError(f"force_dof_vector must have shape ({phi.shape[0]},)", where=where)
+
+
 def response_at_points(
     omega: np.ndarray,
     zeta: np.ndarray | float,
@@ -565,8 +653,10 @@ def response_at_points(
     """Translational response at named points to one force history applied through a dof vector.
 
     The modal force is ``p_j(t) = phi[:, j] . force_dof_vector * f(t)`` (mass-normalised modes,
-    report Eqs. 2.13-2.14), the modal response comes from :func:`modal_pwl_response`, and each point
-    moves by ``T_point @ phi @ eta`` (rigid-body rotation at offset points is in ``T_point``).
+    report Eqs. 2.13-2.14), the modal response is that of :func:`modal_pwl_response`, and each
+    point moves by ``T_point @ phi @ eta`` (rigid-body rotation at offset points is in
+    ``T_point``).  ``T_point phi`` is formed first and contracted with the modal response block
+    by block, so the (3, modes, times) modal array is never built.
 
     Parameters
     ----------
@@ -586,30 +676,361 @@ def response_at_points(
     phi = np.asarray(phi, dtype=float)
     omega = np.asarray(omega, dtype=float)
     b = np.asarray(force_dof_vector, dtype=float)
-    if phi.ndim != 2 or phi.shape[1] != omega.size:
-        raise InputError(f"phi must have shape (n, {omega.size})", where="response_at_points: phi")
-    if b.shape != (phi.shape[0],):
-        raise InputError(
-            f"force_dof_vector must have shape ({phi.shape[0]},)", where="response_at_points"
-        )
+    _check_phi(phi, omega, b, "response_at_points")
     timepts_force = np.asarray(force_history.timepts, dtype=float)
     force = np.asarray(force_history.force, dtype=float)
     gamma = phi.T @ b  # (m,) modal participation per newton
-    modal = modal_pwl_response(omega, zeta, timepts_force, np.outer(gamma, force), timepts_out)
+    omega, zeta_a, timepts_force, modal_force, timepts_out = _as_arrays(
+        omega, zeta, timepts_force, np.outer(gamma, force), timepts_out
+    )
+    names, proj = _point_projection(phi, point_maps, "response_at_points")
+    st = _prepare(omega, zeta_a, timepts_force, modal_force)
+    vals = _evaluate(st, timepts_out, (0, 1, 2), proj)  # (3, 3 P, nt)
     out: dict[str, PointResponse] = {}
-    for name, tmap in point_maps.items():
-        tmap = np.asarray(tmap, dtype=float)
-        if tmap.shape != (3, phi.shape[0]):
-            raise InputError(
-                f"translation map must have shape (3, {phi.shape[0]}), got {tmap.shape}",
-                where=f"response_at_points: point {name!r}",
-            )
-        tphi = tmap @ phi  # (3, m)
+    for i, name in enumerate(names):
+        rows = slice(3 * i, 3 * i + 3)
         out[name] = PointResponse(
             name=name,
-            timepts=modal.timepts,
-            displacement=tphi @ modal.eta,
-            velocity=tphi @ modal.eta_dot,
-            acceleration=tphi @ modal.eta_ddot,
+            timepts=timepts_out,
+            displacement=vals[0, rows],
+            velocity=vals[1, rows],
+            acceleration=vals[2, rows],
+        )
+    return out
+
+
+# --------------------------------------------------------------------------- exact peaks
+
+#: each refinement round cuts every interval that may still hold a higher value into this many
+_SUBDIVIDE = 16
+#: new evaluation times per vectorised batch in the refinement (bounds the scratch memory)
+_PEAK_BATCH = 8192
+
+
+@dataclass(frozen=True)
+class PeakResponse:
+    """The true maximum of a point's exact acceleration over a time window (certified).
+
+    Attributes
+    ----------
+    name : point name
+    window_s : (2,) the closed window [t_start, t_end] searched, s (the output grid's span)
+    peak_accel_mps2 : supremum of the vector magnitude |a(t)| over the window, m/s^2: the largest
+        exact value found (an attained value or a one-sided limit at a force jump)
+    peak_time_s : where it occurs, s
+    peak_side : ``"left"`` when the supremum is the limit from the left at a force jump (the
+        value just before the jump), else ``"right"`` (the right-continuous value at that time)
+    upper_bound_mps2 : certified upper bound of the supremum: the true maximum lies in
+        [peak_accel_mps2, upper_bound_mps2]
+    peak_accel_mps2_axis : (3,) supremum of |a_x|, |a_y|, |a_z|, m/s^2
+    peak_time_s_axis : (3,) where each occurs, s
+    upper_bound_mps2_axis : (3,) certified upper bounds per axis, m/s^2
+    sampled_peak_accel_mps2 : largest |a| at the output times alone (what sampling shows), m/s^2
+    rounds : refinement rounds used
+    """
+
+    name: str
+    window_s: tuple[float, float]
+    peak_accel_mps2: float
+    peak_time_s: float
+    peak_side: str
+    upper_bound_mps2: float
+    peak_accel_mps2_axis: np.ndarray
+    peak_time_s_axis: np.ndarray
+    upper_bound_mps2_axis: np.ndarray
+    sampled_peak_accel_mps2: float
+    rounds: int
+
+    @property
+    def peak_accel_g(self) -> float:
+        """Peak magnitude in standard gravity (G0 = 9.80665 m/s^2)."""
+        return self.peak_accel_mps2 / G0
+
+    @property
+    def peak_accel_g_axis(self) -> np.ndarray:
+        """Peak per axis in standard gravity, shape (3,)."""
+        return self.peak_accel_mps2_axis / G0
+
+    def to_dict(self) -> dict[str, object]:
+        """JSON-ready summary (SI, names carry units)."""
+        return {
+            "name": self.name,
+            "window_s": list(self.window_s),
+            "peak_accel_mps2": self.peak_accel_mps2,
+            "peak_accel_g": self.peak_accel_g,
+            "peak_time_s": self.peak_time_s,
+            "peak_side": self.peak_side,
+            "upper_bound_mps2": self.upper_bound_mps2,
+            "peak_accel_mps2_axis": self.peak_accel_mps2_axis.tolist(),
+            "peak_accel_g_axis": self.peak_accel_g_axis.tolist(),
+            "peak_time_s_axis": self.peak_time_s_axis.tolist(),
+            "upper_bound_mps2_axis": self.upper_bound_mps2_axis.tolist(),
+            "sampled_peak_accel_mps2": self.sampled_peak_accel_mps2,
+            "rounds": self.rounds,
+        }
+
+
+def _one_sided(force: ForceHistory, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Limits from the left and values (right-continuous) of a force history at times ``u``."""
+    tp, fp = np.asarray(force.timepts, float), np.asarray(force.force, float)
+    right = force.at(u)
+    i = np.searchsorted(tp, u, side="left") - 1  # last breakpoint strictly before u
+    last = tp.size - 1
+    i_c = np.clip(i, 0, max(last - 1, 0))
+    if last == 0:
+        left = np.full(u.shape, fp[0])
+    else:
+        t0, t1 = tp[i_c], tp[i_c + 1]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            frac = np.where(t1 > t0, (u - t0) / (t1 - t0), 1.0)
+        left = fp[i_c] + (fp[i_c + 1] - fp[i_c]) * frac
+    left = np.where(i >= last, fp[-1], left)
+    return np.where(i < 0, 0.0, left), right
+
+
+def combined_modal_force(
+    phi: np.ndarray, loads: Sequence[tuple[ForceHistory, np.ndarray]]
+) -> tuple[np.ndarray, np.ndarray]:
+    """Breakpoints and modal force of the sum of several loads, for :func:`modal_pwl_response`.
+
+    The sum of piecewise-linear forces is piecewise linear on the union of their breakpoints.
+    Every union time appears twice: first with the limit from the left, then with the value from
+    that time on (a jump where they differ; the kernel merges equal times).
+
+    Parameters
+    ----------
+    phi : (n, m) mass-normalised mode shapes
+    loads : sequence of (force history, (n,) generalized force per newton); force in N
+
+    Returns
+    -------
+    timepts_force : (2 U,) s
+    modal_force : (m, 2 U) modal force p_j per unit modal mass, m/s^2 per unit coordinate
+    """
+    phi = np.asarray(phi, dtype=float)
+    if not loads:
+        raise InputError("need at least one load", where="loads")
+    u = np.unique(np.concatenate([np.asarray(f.timepts, float) for f, _ in loads]))
+    pf = np.zeros((phi.shape[1], 2 * u.size))
+    for force, b in loads:
+        b = np.asarray(b, dtype=float)
+        if b.shape != (phi.shape[0],):
+            raise InputError(
+                f"a generalized force vector must have shape ({phi.shape[0]},)", where="loads"
+            )
+        left, right = _one_sided(force, u)
+        gamma = phi.T @ b
+        pf[:, 0::2] += np.outer(gamma, left)
+        pf[:, 1::2] += np.outer(gamma, right)
+    return np.repeat(u, 2), pf
+
+
+def _derivative_bounds(
+    st: _State, proj: np.ndarray, t_hi: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Bounds of |a|, |a'|, |a''| of every projected row on every segment, each (R, K).
+
+    Within a segment every modal acceleration obeys the free equation a'' + 2 sigma a' +
+    omega^2 a = 0 (the force is linear there), whose energy E = a'^2 + omega^2 a^2 does not
+    increase (dE/dt = -4 sigma a'^2).  Hence on the segment |a'| <= sqrt(E_k), |a| <=
+    min(sqrt(E_k)/omega, |a_k| + sqrt(E_k) tau_max) and |a''| <= 2 sigma |a'| + omega^2 |a|,
+    with E_k from the state at the segment start (rigid modes: a = p + s tau, the same formulas
+    with omega = 0).  A row's bound is the sum over modes of |T phi| times the modal bound.
+    """
+    w = st.omega[:, None]
+    sig = (st.zeta * st.omega)[:, None]
+    sqrt_e = np.hypot(st.jerk, w * st.acc)  # (m, K)
+    seg_end = np.r_[st.starts[1:], np.inf]
+    tau_max = np.maximum(np.minimum(seg_end, t_hi) - st.starts, 0.0)[None, :]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        by_energy = np.where(w > 0, sqrt_e / w, np.inf)
+    b0 = np.minimum(by_energy, np.abs(st.acc) + sqrt_e * tau_max)
+    b1 = sqrt_e
+    b2 = 2.0 * sig * b1 + w * w * b0
+    ap = np.abs(proj)
+    return ap @ b0, ap @ b1, ap @ b2
+
+
+def peak_response(
+    omega: np.ndarray,
+    zeta: np.ndarray | float,
+    phi: np.ndarray,
+    point_maps: Mapping[str, np.ndarray],
+    loads: Sequence[tuple[ForceHistory, np.ndarray]],
+    timepts_out: np.ndarray,
+    *,
+    rtol: float = 1e-9,
+    max_rounds: int = 30,
+) -> dict[str, PeakResponse]:
+    """True maximum of the exact acceleration at named points, with a certified bound.
+
+    The acceleration is that of :func:`response_at_points` summed over ``loads``.  It is
+    evaluated exactly (closed form) at the output times, at every force breakpoint inside the
+    window with both one-sided limits at a jump (the limit from the left is the end of the
+    previous segment), then refined between samples: within a force segment each modal
+    acceleration is a damped sinusoid (rigid: a line), and :func:`_derivative_bounds` bounds the
+    second derivative ``M2`` of each axis (and of |a|^2) on the segment.  An interval of length
+    ``h`` whose end values are ``f_a, f_b`` cannot exceed ``max(f_a, f_b) + M2 h^2 / 8`` (Taylor
+    about an interior stationary point); intervals that might exceed the best value found are cut
+    into 16 and evaluated again, until none might exceed it by more than ``rtol``.
+
+    Guarantee: the true supremum over the window [timepts_out[0], timepts_out[-1]] lies in
+    ``[peak, upper_bound]``, and ``upper_bound <= peak (1 + rtol)`` unless ``max_rounds`` ran out
+    (then ``upper_bound`` still holds and says how far off the peak may be).
+
+    Parameters
+    ----------
+    omega : (m,) natural frequencies, rad/s (0 for rigid-body modes)
+    zeta : (m,) or scalar modal damping ratios, 0 <= zeta < 1
+    phi : (n, m) mass-normalised mode shapes (phi^T M phi = I)
+    point_maps : name -> (3, n) translation map of the point, m per unit generalized coordinate
+    loads : sequence of (ForceHistory, (n,) generalized force per newton), forces in N; the
+        responses add (see :func:`combined_modal_force`)
+    timepts_out : (nt,) sorted output times, s; their span is the window searched
+    rtol : relative tolerance of the certified bound (> 0)
+    max_rounds : largest number of refinement rounds (>= 0)
+
+    Returns
+    -------
+    dict name -> PeakResponse (m/s^2, s)
+    """
+    phi = np.asarray(phi, dtype=float)
+    omega = np.asarray(omega, dtype=float)
+    if not (np.isfinite(rtol) and rtol > 0):
+        raise InputError(f"must be a number > 0, got {rtol!r}", where="rtol")
+    if not (isinstance(max_rounds, int | np.integer) and max_rounds >= 0):
+        raise InputError(f"must be an integer >= 0, got {max_rounds!r}", where="max_rounds")
+    if phi.ndim != 2 or phi.shape[1] != omega.size:
+        raise InputError(f"phi must have shape (n, {omega.size})", where="peak_response: phi")
+    tb, pf = combined_modal_force(phi, loads)
+    omega, zeta_a, tb, pf, t = _as_arrays(omega, zeta, tb, pf, timepts_out)
+    if t.size == 0:
+        raise InputError("need at least one output time", where="timepts_out")
+    names, proj = _point_projection(phi, point_maps, "peak_response")
+    st = _prepare(omega, zeta_a, tb, pf)
+    n_pts = len(names)
+    t_lo, t_hi = float(t[0]), float(t[-1])
+    starts = st.starts
+    K = starts.size
+
+    def accel(seg: np.ndarray, tt: np.ndarray) -> np.ndarray:
+        """Projected acceleration (R, n) at times tt evaluated on segments seg (-1: zero)."""
+        res = np.zeros((proj.shape[0], tt.size))
+        ok = np.flatnonzero(seg >= 0)
+        for c0 in range(0, ok.size, _PEAK_BATCH):
+            idx = ok[c0 : c0 + _PEAK_BATCH]
+            sg = seg[idx]
+            res[:, idx] = proj @ _direct(st, sg, tt[idx] - starts[sg], (2,))[0]
+        return res
+
+    # 1. samples: the output grid (right-continuous values) and the one-sided limits at jumps
+    grid_vals = _evaluate(st, t, (2,), proj)[0]  # (R, nt)
+    grid_seg = np.searchsorted(starts, t, side="right") - 1
+    k_right = np.flatnonzero((starts >= t_lo) & (starts <= t_hi))
+    k_left = np.flatnonzero((starts > t_lo) & (starts <= t_hi))
+    seg_left = k_left - 1
+    times = np.concatenate([t, starts[k_right], starts[k_left]])
+    segs = np.concatenate([grid_seg, k_right, seg_left])
+    side = np.concatenate([np.ones(t.size + k_right.size), np.zeros(k_left.size)])  # 0: left
+    extra = accel(
+        np.concatenate([k_right, seg_left]), np.concatenate([starts[k_right], starts[k_left]])
+    )
+    vals = np.concatenate([grid_vals, extra], axis=1)
+    order = np.lexsort((side, times))
+    times, segs, side, vals = times[order], segs[order], side[order], vals[:, order]
+
+    b0, b1, b2 = _derivative_bounds(st, proj, t_hi)  # (R, K)
+    bF = 2.0 * (b1 * b1 + b0 * b2).reshape(n_pts, 3, K).sum(axis=1)  # bound of |(|a|^2)''|
+    b2 = np.where(np.isfinite(b2), b2, np.inf)
+
+    def mag2(v: np.ndarray) -> np.ndarray:
+        return (v * v).reshape(n_pts, 3, *v.shape[1:]).sum(axis=1)
+
+    absv = np.abs(vals)
+    best_ax = absv.max(axis=1, initial=0.0)  # (R,)
+    arg_ax = absv.argmax(axis=1) if times.size else np.zeros(proj.shape[0], int)
+    t_ax, side_ax = times[arg_ax], side[arg_ax]
+    F = mag2(vals)
+    best_F = F.max(axis=1, initial=0.0)
+    arg_F = F.argmax(axis=1)
+    t_F, side_F = times[arg_F], side[arg_F]
+    sampled = np.sqrt(mag2(grid_vals).max(axis=1, initial=0.0))
+
+    # 2. intervals inside one segment (a jump separates its two limits: no interval across it)
+    link = np.flatnonzero((segs[1:] == segs[:-1]) & (segs[:-1] >= 0) & (np.diff(times) > 0))
+    ta, tb_, sg = times[link], times[link + 1], segs[link]
+    va, vb = vals[:, link], vals[:, link + 1]
+    rounds = 0
+    grow = 1.0 + rtol
+
+    def bounds(
+        ta: np.ndarray, tb_: np.ndarray, sg: np.ndarray, va: np.ndarray, vb: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        h2 = (tb_ - ta) ** 2 / 8.0
+        u_ax = np.maximum(np.abs(va), np.abs(vb)) + b2[:, sg] * h2
+        u_F = np.maximum(mag2(va), mag2(vb)) + bF[:, sg] * h2
+        return u_ax, u_F
+
+    u_ax, u_F = bounds(ta, tb_, sg, va, vb)
+    # largest bound of every interval set aside: the certified bound of the supremum
+    drop_ax = np.zeros(proj.shape[0])
+    drop_F = np.zeros(n_pts)
+    while True:
+        active = np.any(u_ax > best_ax[:, None] * grow, axis=0) | np.any(
+            u_F > best_F[:, None] * grow * grow, axis=0
+        )
+        gone = ~active
+        drop_ax = np.maximum(drop_ax, u_ax[:, gone].max(axis=1, initial=0.0))
+        drop_F = np.maximum(drop_F, u_F[:, gone].max(axis=1, initial=0.0))
+        keep = np.flatnonzero(active)
+        ta, tb_, sg, va, vb = ta[keep], tb_[keep], sg[keep], va[:, keep], vb[:, keep]
+        u_ax, u_F = u_ax[:, keep], u_F[:, keep]
+        if keep.size == 0 or rounds >= max_rounds:
+            break
+        rounds += 1
+        frac = np.arange(1, _SUBDIVIDE) / _SUBDIVIDE
+        tn = ta[:, None] + (tb_ - ta)[:, None] * frac  # (na, S-1)
+        sn = np.broadcast_to(sg[:, None], tn.shape)
+        vn = accel(sn.ravel(), tn.ravel()).reshape(proj.shape[0], *tn.shape)
+        # new best values
+        an = np.abs(vn).reshape(proj.shape[0], -1)
+        i_ax = an.argmax(axis=1)
+        better = an[np.arange(an.shape[0]), i_ax] > best_ax
+        best_ax = np.where(better, an[np.arange(an.shape[0]), i_ax], best_ax)
+        t_ax = np.where(better, tn.ravel()[i_ax], t_ax)
+        side_ax = np.where(better, 1.0, side_ax)
+        Fn = mag2(vn.reshape(proj.shape[0], -1))
+        i_F = Fn.argmax(axis=1)
+        betterF = Fn[np.arange(n_pts), i_F] > best_F
+        best_F = np.where(betterF, Fn[np.arange(n_pts), i_F], best_F)
+        t_F = np.where(betterF, tn.ravel()[i_F], t_F)
+        side_F = np.where(betterF, 1.0, side_F)
+        # the sub-intervals
+        pts_t = np.concatenate([ta[:, None], tn, tb_[:, None]], axis=1)  # (na, S+1)
+        pts_v = np.concatenate([va[:, :, None], vn, vb[:, :, None]], axis=2)  # (R, na, S+1)
+        ta = pts_t[:, :-1].ravel()
+        tb_ = pts_t[:, 1:].ravel()
+        sg = np.repeat(sg, _SUBDIVIDE)
+        va = pts_v[:, :, :-1].reshape(proj.shape[0], -1)
+        vb = pts_v[:, :, 1:].reshape(proj.shape[0], -1)
+        u_ax, u_F = bounds(ta, tb_, sg, va, vb)
+
+    up_ax = np.maximum(np.maximum(best_ax, drop_ax), u_ax.max(axis=1, initial=0.0))
+    up_F = np.maximum(np.maximum(best_F, drop_F), u_F.max(axis=1, initial=0.0))
+    out: dict[str, PeakResponse] = {}
+    for i, name in enumerate(names):
+        r = slice(3 * i, 3 * i + 3)
+        out[name] = PeakResponse(
+            name=name,
+            window_s=(t_lo, t_hi),
+            peak_accel_mps2=float(np.sqrt(best_F[i])),
+            peak_time_s=float(t_F[i]),
+            peak_side="left" if side_F[i] == 0 else "right",
+            upper_bound_mps2=float(np.sqrt(up_F[i])),
+            peak_accel_mps2_axis=best_ax[r].copy(),
+            peak_time_s_axis=np.asarray(t_ax[r], float).copy(),
+            upper_bound_mps2_axis=up_ax[r].copy(),
+            sampled_peak_accel_mps2=float(sampled[i]),
+            rounds=rounds,
         )
     return out

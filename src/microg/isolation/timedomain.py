@@ -15,8 +15,10 @@ exact step from ``t_j`` to ``t_j + h`` is read from one matrix exponential of th
     x_{j+1} = Phi x_j + G1 a0_j + G2 (a0_{j+1} - a0_j)/h.
 
 One exponential per distinct step (steps equal to within the rounding of the time points share
-one); the recursion is evaluated as a chunked parallel prefix scan of the affine maps (vectorised,
-no loop over samples), so non-uniform steps cost nothing extra.
+one).  The recursion is the one blocked O(N) scan of :mod:`microg._scan`: on a uniform grid
+(one shared map) :func:`~microg._scan.lti_scan` computes only the two outputs (package
+acceleration and stroke), otherwise :func:`~microg._scan.affine_scan` gives the states.  Both
+are vectorised over blocks of about sqrt(N) steps, with no loop over samples.
 
 Initial condition: the package (and absorber) start at rest relative to the mount, ``z = z' = 0``
 at ``timepts[0]``.
@@ -31,6 +33,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import linalg
 
+from microg._scan import affine_scan, lti_scan
 from microg.errors import InputError
 
 __all__ = [
@@ -40,8 +43,6 @@ __all__ = [
     "foh_discretize",
     "package_response",
 ]
-
-_CHUNK = 4096
 
 
 @dataclass(frozen=True)
@@ -190,48 +191,20 @@ def foh_discretize(
 
 
 def _group_steps(
-    h: NDArray[np.float64], tmax: float
+    h: NDArray[np.float64], tmax: float, span: float
 ) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
-    """Distinct steps, merging those equal to within the rounding of the time points."""
+    """Distinct steps, merging those equal to within the rounding of the time points.
+
+    A uniform grid (every step within the rounding of the mean step ``span / (N - 1)``) gets
+    the one map of the mean step: no bias accumulates over many steps.
+    """
     tol = 8.0 * np.finfo(float).eps * max(tmax, float(h.max()))
+    mean = span / h.size
+    if float(np.max(np.abs(h - mean))) <= tol:
+        return np.array([mean]), np.zeros(h.size, dtype=np.intp)
     keys = np.rint(h / tol)
     _, first, inverse = np.unique(keys, return_index=True, return_inverse=True)
     return h[first], inverse.reshape(-1)
-
-
-def _affine_scan(
-    Phi: NDArray[np.float64],
-    G1: NDArray[np.float64],
-    G2: NDArray[np.float64],
-    index: NDArray[np.intp],
-    u: NDArray[np.float64],
-    slope: NDArray[np.float64],
-    n: int,
-) -> NDArray[np.float64]:
-    """States ``x_j``, shape (N+1, n), of ``x_{j+1} = Phi_j x_j + G1_j u_j + G2_j s_j``, x_0 = 0.
-
-    Hillis-Steele prefix scan of the affine maps within chunks of ``_CHUNK`` steps, the state
-    carried between chunks (a loop over chunks, not samples).
-    """
-    n_steps = index.size
-    X = np.zeros((n_steps + 1, n))
-    x = np.zeros(n)
-    for start in range(0, n_steps, _CHUNK):
-        sl = slice(start, min(start + _CHUNK, n_steps))
-        idx = index[sl]
-        P = Phi[idx].copy()
-        G = G1[idx] * u[sl, None] + G2[idx] * slope[sl, None]
-        m = idx.size
-        d = 1
-        while d < m:
-            newG = np.einsum("kij,kj->ki", P[d:], G[:-d]) + G[d:]
-            newP = np.matmul(P[d:], P[:-d])
-            G[d:] = newG
-            P[d:] = newP
-            d *= 2
-        X[start + 1 : start + m + 1] = np.einsum("kij,j->ki", P, x) + G
-        x = X[start + m]
-    return X
 
 
 @dataclass
@@ -303,23 +276,31 @@ def package_response(
         raise InputError(f"shape {a0.shape} differs from timepts {t.shape}", where="mount_accel")
     if not (np.all(np.isfinite(t)) and np.all(np.isfinite(a0))):
         raise InputError("contains NaN or inf", where="timepts/mount_accel")
-    if not np.all(np.diff(t) > 0):
+    h = np.diff(t)
+    if not np.all(h > 0):
         raise InputError("times must be strictly increasing", where="timepts")
     if not (isinstance(oversample, int | np.integer) and oversample >= 1):
         raise InputError(f"must be an integer >= 1, got {oversample!r}", where="oversample")
     if oversample > 1:
         frac = np.arange(oversample) / oversample
-        h0 = np.diff(t)
-        t = np.concatenate(((t[:-1, None] + h0[:, None] * frac).ravel(), t[-1:]))
+        t = np.concatenate(((t[:-1, None] + h[:, None] * frac).ravel(), t[-1:]))
         a0 = np.concatenate(((a0[:-1, None] + np.diff(a0)[:, None] * frac).ravel(), a0[-1:]))
+        h = np.diff(t)
     A, B, C = state_space(model)
-    h = np.diff(t)
-    h_unique, index = _group_steps(h, float(np.max(np.abs(t))))
+    h_unique, index = _group_steps(h, float(np.max(np.abs(t))), float(t[-1] - t[0]))
     Phi, G1, G2 = foh_discretize(A, B, h_unique)
-    slope = np.diff(a0) / h
-    X = _affine_scan(Phi, G1, G2, index, a0[:-1], slope, A.shape[0])
-    y = X @ C[0]
-    stroke = X[:, 0]
+    inputs = np.empty((h.size, 2))  # value at the step start and slope over the step
+    inputs[:, 0] = a0[:-1]
+    np.divide(np.diff(a0), h, out=inputs[:, 1])
+    if h_unique.size == 1:  # uniform steps: one map, only the two outputs are computed
+        out_map = np.vstack([C, np.eye(A.shape[0])[:1]])  # package acceleration, stroke
+        Y = lti_scan(Phi[0], np.stack([G1[0], G2[0]]), inputs, out_map)
+        y, stroke = Y[:, 0], Y[:, 1]
+    else:
+        offsets = G1[index] * inputs[:, :1] + G2[index] * inputs[:, 1:]
+        X = affine_scan(Phi, offsets, index=index)
+        y = X @ C[0]
+        stroke = X[:, 0]
     peak_mount = float(np.max(np.abs(a0)))
     peak_package = float(np.max(np.abs(y)))
     rms_mount = _rms(t, a0)
