@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import json
+import re
+import sys
 
 import numpy as np
 import pytest
@@ -10,10 +12,47 @@ import pytest
 from microg.cli import main
 from microg.dynamics.crew import CrewPushoff
 from microg.dynamics.modes import solve_modes
-from microg.location.amap import acceleration_map
+from microg.location.amap import acceleration_map, locate
 from microg.models.toml import load_station
-from microg.structure.ritz import build_ritz
-from microg.units import G0
+from microg.structure.discretize import discretize
+from microg.units import FT, G0
+
+SI_MODEL = """
+[station]
+name = "small"
+units = "SI"
+[orbit]
+altitude = "500 km"
+[[body]]
+name = "core"
+  [[body.mass]]
+  name = "hab"
+  mass = "20000 kg"
+  at = ["0 m", "0 m", "-4 m"]
+  [[body.mass]]
+  name = "dock"
+  mass = "30000 kg"
+  at = ["0 m", "0 m", "-20 m"]
+[[beam]]
+name = "keel"
+parent = "core"
+root = ["0 m", "0 m", "0 m"]
+direction = "+z"
+length = "60 m"
+ei = "4e8 N*m^2"
+gj = "1e8 N*m^2"
+mass_per_length = "20 kg/m"
+[[point]]
+name = "lab"
+on = "core"
+at = ["0 m", "0 m", "-12 m"]
+kind = "experiment"
+[[point]]
+name = "crew"
+on = "core"
+at = ["0 m", "0 m", "-12 m"]
+kind = "crew"
+"""
 
 
 def _run(capsys, *args):
@@ -22,13 +61,35 @@ def _run(capsys, *args):
     return rc, out, err
 
 
+@pytest.fixture
+def si_model(tmp_path):
+    path = tmp_path / "small.toml"
+    path.write_text(SI_MODEL)
+    return path
+
+
+@pytest.fixture
+def unitless_model(tmp_path):
+    # the same model with no unit system: every value carries its unit, bare numbers do not
+    path = tmp_path / "plain.toml"
+    path.write_text(SI_MODEL.replace('units = "SI"\n', ""))
+    return path
+
+
+@pytest.fixture
+def crewless_model(tmp_path):
+    path = tmp_path / "nocrew.toml"
+    path.write_text(SI_MODEL.replace('kind = "crew"\n', ""))
+    return path
+
+
 def test_locate_json_matches_library(capsys):
     rc, out, err = _run(capsys, "locate", "ioc", "--crew", "crew", "--json", "--on", "main")
     assert rc == 0 and err == ""
     data = json.loads(out)
     for key in ("samples", "nodes", "best_location", "modes", "fundamental", "window_s"):
         assert key in data
-    s = build_ritz(load_station("ioc"), "xz", 1)
+    s = discretize(load_station("ioc"), "ritz", plane="xz", n=1)
     ref = acceleration_map(s, solve_modes(s), "crew", "x", CrewPushoff(25 * 4.4482216152605))
     total = np.array([x["total_peak_g"] for x in data["samples"]])
     np.testing.assert_allclose(total, ref.total_peak / G0, rtol=1e-12)
@@ -37,6 +98,20 @@ def test_locate_json_matches_library(capsys):
     assert data["best_location"]["peak_g"] == min(on_main)
     assert len(data["samples"][0]["per_mode_g"]) == len(data["modes"])
     assert {n["component"] for n in data["nodes"]} >= {"main"}
+    # the JSON is the library result's to_dict()
+    same_force = CrewPushoff(data["force"]["f0_N"])
+    assert data == json.loads(
+        json.dumps(locate("ioc", "crew", force=same_force, on="main").to_dict())
+    )
+
+
+def test_locate_defaults_to_the_models_crew_point(capsys):
+    # issue 9: `microg locate ioc` printed "microg: error: --crew: " (no message)
+    rc, out, err = _run(capsys, "locate", "ioc", "--json")
+    assert rc == 0 and err == ""
+    data = json.loads(out)
+    first_crew = [p.name for p in load_station("ioc").points if p.kind == "crew"][0]
+    assert data["crew_point"] == first_crew == "crew"
 
 
 def test_locate_writes_png_and_json(capsys, tmp_path):
@@ -73,70 +148,97 @@ def test_locate_fem_and_damping(capsys):
     assert data["fundamental"]["omega"] == pytest.approx(1.0086, rel=1e-3)
 
 
-@pytest.mark.parametrize(
-    ("args", "needle"),
-    [
-        (["locate", "ioc", "--crew", "nowhere"], "known points: boom-tip, crew"),
-        (["locate", "ioc"], "--crew"),
-        (["locate", "ioc", "--crew", "crew", "--direction", "z"], "--direction"),
-        (["locate", "ioc", "--crew", "crew", "--damping", "1.5"], "--damping"),
-        (["locate", "ioc", "--crew", "crew", "--f0", "3 m"], "--f0"),
-        (["locate", "ioc", "--crew", "crew", "--on", "hull"], "known components"),
-        (["locate", "nope", "--crew", "crew"], "no such file"),
-        (["optimize", "ioc", "--experiment", "lab", "--crew", "crew"], "no movable"),
-        (
-            ["optimize", "ioc", "--experiment", "lab", "--crew", "crew", "--movable", "Piano=0:1"],
-            "known masses",
-        ),
-        (
-            ["optimize", "ioc", "--experiment", "lab", "--crew", "crew", "--movable", "x"],
-            "NAME=LO:HI",
-        ),
-        (
-            [
-                "optimize",
-                "ioc",
-                "--experiment",
-                "lab",
-                "--crew",
-                "crew",
-                "--movable",
-                "TDM 2010=0:10",
-            ],
-            "ambiguous",
-        ),
-        (
-            [
-                "optimize",
-                "ioc",
-                "--experiment",
-                "lab",
-                "--crew",
-                "crew",
-                "--movable",
-                "Horizontal lab=-200ft:0ft",
-            ],
-            "leaves the body",
-        ),
-        (
-            [
-                "optimize",
-                "ioc",
-                "--experiment",
-                "nowhere",
-                "--crew",
-                "crew",
-                "--movable",
-                "Horizontal lab=-91ft:-5ft",
-            ],
-            "unknown point",
-        ),
-    ],
-)
+def test_out_is_checked_before_computing(capsys, tmp_path, monkeypatch):
+    # issue 9: an unwritable --out failed only after the computation
+    import microg.location.amap as amap
+
+    def boom(*args, **kwargs):
+        raise AssertionError("computed before checking --out")
+
+    monkeypatch.setattr(amap, "locate", boom)
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    rc, out, err = _run(capsys, "locate", "ioc", "--out", str(blocker / "sub"))
+    assert rc == 2 and out == "" and err.startswith("microg: error: --out: ")
+
+
+BAD = [
+    (["locate", "ioc", "--crew", "nowhere"], "--crew: unknown point 'nowhere'"),
+    (["locate", "ioc", "--crew", "nowhere"], "known points: boom-tip, crew"),
+    (["locate", "ioc", "--crew", "crew", "--direction", "z"], "--direction"),
+    (["locate", "ioc", "--crew", "crew", "--direction", "w"], "--direction"),
+    (["locate", "ioc", "--crew", "crew", "--damping", "1.5"], "--damping"),
+    (["locate", "ioc", "--crew", "crew", "--f0", "3 m"], "--f0"),
+    (["locate", "ioc", "--crew", "crew", "--on", "hull"], "--on: no samples on 'hull'"),
+    (["locate", "ioc", "--crew", "crew", "--on", "hull"], "known components"),
+    (["locate", "ioc", "--elements", "3"], "--elements"),
+    (["locate", "ioc", "--method", "fem", "--functions", "3"], "--functions"),
+    (["locate", "nope", "--crew", "crew"], "no such file"),
+    (["optimize", "ioc", "--experiment", "lab", "--crew", "crew"], "--movable: no movable"),
+    (
+        ["optimize", "ioc", "--experiment", "lab", "--crew", "crew", "--movable", "Piano=0:1"],
+        "known masses",
+    ),
+    (
+        ["optimize", "ioc", "--experiment", "lab", "--crew", "crew", "--movable", "x"],
+        "NAME=LO:HI",
+    ),
+    (
+        ["optimize", "ioc", "--experiment", "lab", "--crew", "crew", "--movable", "TDM 2010=0:10"],
+        "ambiguous",
+    ),
+    (
+        [
+            "optimize",
+            "ioc",
+            "--experiment",
+            "lab",
+            "--crew",
+            "crew",
+            "--movable",
+            "Horizontal lab=-200ft:0ft",
+        ],
+        "leaves the body",
+    ),
+    (
+        [
+            "optimize",
+            "ioc",
+            "--experiment",
+            "nowhere",
+            "--crew",
+            "crew",
+            "--movable",
+            "Horizontal lab=-91ft:-5ft",
+        ],
+        "--experiment: unknown point",
+    ),
+    (
+        ["optimize", "ioc", "--movable", "Horizontal lab=-91ft:-5ft", "--carry", "lab=Piano"],
+        "--carry lab",
+    ),
+    (["optimize", "ioc", "--movable", "Horizontal lab=-91ft:-5ft", "--maxiter", "0"], "--maxiter"),
+    (
+        ["optimize", "ioc", "--movable", "Horizontal lab=-91ft:-5ft", "--maxiter", "1001"],
+        "--maxiter",
+    ),
+]
+
+
+@pytest.mark.parametrize(("args", "needle"), BAD)
 def test_bad_input_is_one_line_exit_2(capsys, tmp_path, args, needle):
     rc, out, err = _run(capsys, *args)
     assert rc == 2 and out == ""
     assert len(err.strip().splitlines()) == 1 and needle in err
+    # issue 9: never a blank message ("microg: error: --crew: " and nothing after it)
+    assert re.match(r"^microg: error: (--[\w-]+( [^:]+)?: )?\S", err), err
+
+
+def test_model_without_crew_point_is_a_message(capsys, crewless_model):
+    rc, out, err = _run(capsys, "locate", str(crewless_model))
+    assert rc == 2 and out == ""
+    assert err.startswith("microg: error: --crew: the model has no crew point")
+    assert "name one of: lab, crew" in err
 
 
 def test_bad_input_writes_nothing(capsys, tmp_path):
@@ -169,3 +271,52 @@ def test_optimize_json(capsys):
         assert m["bounds_m"][0] <= m["optimal_m"] <= m["bounds_m"][1]
     assert data["objective_optimal_g"] <= data["objective_initial_g"]
     assert data["n_evaluations"] >= 1
+    # the objective is the total peak, with its rigid and elastic parts beside it
+    assert data["measure"] == "total"
+    assert data["objective_optimal_g"] == data["optimal"]["total_g"]
+    assert data["optimal"]["rigid_g"] > 0 and data["optimal"]["elastic_g"] > 0
+
+
+def test_optimize_readme_example_reports_total_and_parts(capsys):
+    # README: microg optimize ioc --experiment lab --crew crew --movable "Horizontal lab=..."
+    args = ["optimize", "ioc", "--experiment", "lab", "--crew", "crew"]
+    rc, out, err = _run(capsys, *args, "--movable", "Horizontal lab=-91ft:-5ft")
+    assert rc == 0 and err == ""  # not a TTY: no progress bar
+    m = re.search(r"total peak \(objective\): (\S+) g -> (\S+) g \(x(\S+) lower\)", out)
+    assert m, out
+    before, after, gain = (float(v) for v in m.groups())
+    # the rigid translation f0/M alone (4.1e-5 g for the IOC) bounds what a layout can reach;
+    # the report's gain must be of that order (issue 9 found x5.06e+31)
+    f0_over_m = 25 * 4.4482216152605 / load_station("ioc").mass_properties()[0] / G0
+    assert after > 0.5 * f0_over_m and 1.0 <= gain <= before / (0.5 * f0_over_m)
+    assert "rigid-body" in out and "elastic" in out
+
+
+def test_bare_numbers_in_movable_take_the_models_units(capsys, si_model, unitless_model):
+    # issue 9: bare numbers were ft even in an SI model (the dock at -20 m is outside
+    # -20 ft .. -4 ft = -6.1 .. -1.2 m, so ft would be an error)
+    base = ["optimize", "--maxiter", "2", "--json", "--no-progress"]
+    rc, out, err = _run(capsys, *base[:1], str(si_model), *base[1:], "--movable", "dock=-20:-4")
+    assert rc == 0, err
+    assert json.loads(out)["masses"][0]["bounds_m"] == [-20.0, -4.0]
+    # the US model: ft
+    rc, out, err = _run(capsys, "optimize", "ioc", *base[1:], "--movable", "Horizontal lab=-91:-5")
+    assert rc == 0, err
+    lo, hi = json.loads(out)["masses"][0]["bounds_m"]
+    assert (lo, hi) == pytest.approx((-91 * FT, -5 * FT), rel=1e-15)
+    # no unit system: an error naming the option and the fix
+    rc, out, err = _run(
+        capsys, "optimize", str(unitless_model), *base[1:], "--movable", "dock=-20:-4"
+    )
+    assert rc == 2 and out == ""
+    assert err.startswith("microg: error: --movable core/dock: bare number '-20' has no unit")
+    assert "units = " in err
+
+
+def test_progress_bar_on_a_tty_only(capsys, monkeypatch):
+    args = ["optimize", "ioc", "--movable", "Horizontal lab=-91ft:-5ft", "--maxiter", "2"]
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: True, raising=False)
+    rc, out, err = _run(capsys, *args)
+    assert rc == 0 and "microg optimize" in err
+    rc, out, err = _run(capsys, *args, "--no-progress")
+    assert rc == 0 and err == ""

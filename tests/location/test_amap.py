@@ -1,85 +1,35 @@
-"""Tests of microg.location.amap: acceleration map (Eqs. 2.20b/3.1), nodes, optimiser."""
+"""Tests of microg.location.amap: the acceleration map (Eqs. 2.20b/3.1), point peaks, locate()."""
 
 from __future__ import annotations
-
-import dataclasses
 
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
 from microg.dynamics.crew import CrewPushoff, acceleration_a
-from microg.dynamics.dense import solve_dense
 from microg.dynamics.forces import REPORT_F0_N
 from microg.dynamics.modes import solve_modes
 from microg.errors import InputError
 from microg.location.amap import (
+    DEFAULTS,
     acceleration_map,
     best_location,
-    conclusion7,
-    elastic_mask,
-    layout_objective,
-    movable_masses,
-    move_masses,
-    optimize_layout,
-    resolve_mass,
+    locate,
+    point_peak,
 )
-from microg.models.station import NamedPoint
-from microg.models.toml import load_station, loads_station
-from microg.seed.ioc import report_matrices
-from microg.structure.ritz import build_ritz
+from microg.location.peaks import elastic_modes
+from microg.models.toml import load_station
+from microg.structure.discretize import discretize
+from microg.units import G0
 
-FT = 0.3048
 CREW = CrewPushoff(REPORT_F0_N)
-
-SMALL = """
-[station]
-name = "small"
-units = "SI"
-[orbit]
-altitude = "500 km"
-[[body]]
-name = "core"
-  [[body.mass]]
-  name = "hab"
-  mass = "20000 kg"
-  at = ["0 m", "0 m", "-4 m"]
-  [[body.mass]]
-  name = "lab-module"
-  mass = "15000 kg"
-  at = ["0 m", "0 m", "-12 m"]
-  [[body.mass]]
-  name = "dock"
-  mass = "30000 kg"
-  at = ["0 m", "0 m", "-20 m"]
-[[beam]]
-name = "keel"
-parent = "core"
-root = ["0 m", "0 m", "0 m"]
-direction = "+z"
-length = "60 m"
-ei = "4e8 N*m^2"
-gj = "1e8 N*m^2"
-mass_per_length = "20 kg/m"
-  [[beam.mass]]
-  name = "tip"
-  mass = "8000 kg"
-  s = "60 m"
-[[point]]
-name = "lab"
-on = "core"
-at = ["0 m", "0 m", "-12 m"]
-[[point]]
-name = "crew"
-on = "core"
-at = ["0 m", "0 m", "-12 m"]
-"""
 
 
 @pytest.fixture(scope="module")
 def ioc():
+    # the location stage's structure: the one entry, free-free (locate's pipeline)
     station = load_station("ioc")
-    structure = build_ritz(station, "xz", 1)
+    structure = discretize(station, "ritz", plane="xz", n=1)
     return station, structure, solve_modes(structure)
 
 
@@ -102,7 +52,7 @@ def test_per_mode_map_is_eq_3_1_at_the_lab(ioc, ioc_map):
     lab = structure.point("lab")
     i = _sample_at(ioc_map, lab.position)
     phi_lab = (lab.translation @ modes.phi)[0]  # x translation, mass-normalised (M_jj = 1)
-    el = elastic_mask(modes.omega, modes.rigid)
+    el = elastic_modes(modes)
     # A(t) jumps at t1, t13 (force jumps): the sup there is the one-sided limit, so the grid
     # also holds the instants just after each jump
     jumps = np.array([CREW.t1, CREW.t13, CREW.t14]) + 1e-12
@@ -116,12 +66,35 @@ def test_per_mode_map_is_eq_3_1_at_the_lab(ioc, ioc_map):
         assert ioc_map.per_mode[j, i] == pytest.approx(direct, rel=1e-6, abs=1e-30)
 
 
-def test_rigid_translation_is_f0_over_total_mass_everywhere(ioc, ioc_map):
-    # a mass-normalised rigid translation gives f0 / M at every point (Newton's second law)
-    station, _, modes = ioc
+def test_rigid_translation_is_f0_over_total_mass_everywhere():
+    # with gravity gradient the rotation is restrained (libration), so the only exact rigid
+    # mode is the translation: mass-normalised, it gives f0 / M at every point (Newton)
+    station = load_station("ioc")
+    structure = discretize(station, "ritz", plane="xz", n=1, gravity_gradient=True)
+    modes = solve_modes(structure)
+    amap = acceleration_map(structure, modes, "crew", "x", CREW)
     total, _, _ = station.mass_properties()
-    j = int(np.flatnonzero(modes.rigid)[0])
-    np.testing.assert_allclose(ioc_map.per_mode[j], CREW.f0 / total, rtol=1e-10)
+    (j,) = np.flatnonzero(modes.rigid)
+    np.testing.assert_allclose(amap.per_mode[j], CREW.f0 / total, rtol=1e-10)
+
+
+def test_rigid_part_is_newton_euler_of_the_free_body(ioc, ioc_map):
+    # reference: the rigid-body motion of the free structure without modes, by projecting on
+    # the exact rigid vectors R = [r_x, r_ry]: a(s) = T_s R (R^T M R)^-1 R^T T_a^T f0 (Newton
+    # and Euler in generalized coordinates).  It does not depend on how the eigensolver
+    # chose its basis of the two-dimensional rigid subspace; the map's rigid_peak must not.
+    _, structure, _ = ioc
+    m, _ = structure.dense()
+    r = np.column_stack([structure.rigid_body[k] for k in ("x", "ry")])
+    crew = structure.point("crew").translation[0]
+    proj = r @ np.linalg.solve(r.T @ m @ r, r.T @ crew)
+    i = _sample_at(ioc_map, structure.point("lab").position)
+    ref = abs(structure.point("lab").translation[0] @ proj) * CREW.f0
+    # both are a few products of O(1) numbers: rounding only
+    assert ioc_map.rigid_peak[i] == pytest.approx(ref, rel=1e-10)
+    # f0/M alone is the translation; the lab (12 ft from the centre of mass, with the crew)
+    # also gets the rotation's share, which has the same sign there
+    assert ioc_map.rigid_peak[i] > CREW.f0 / structure.total_mass
 
 
 def test_total_peak_matches_direct_integration_and_bound(ioc, ioc_map):
@@ -131,7 +104,6 @@ def test_total_peak_matches_direct_integration_and_bound(ioc, ioc_map):
     m, k = structure.dense()
     lab = structure.point("lab")
     b = lab.translation[0]  # generalized force per newton along x at the crew point
-    tb, fb = CREW.breakpoints()
     minv = np.linalg.inv(m)
     n = m.shape[0]
     t_end = ioc_map.window[1]
@@ -164,32 +136,6 @@ def test_total_peak_matches_direct_integration_and_bound(ioc, ioc_map):
     assert np.all(ioc_map.long_time_peak <= ioc_map.peak_bound * (1 + 1e-12))
 
 
-def _station_with_point(station, name, on, position):
-    pts = (*station.points, NamedPoint(name, on, np.asarray(position, float)))
-    return dataclasses.replace(station, points=pts)
-
-
-def test_nodes_are_zeros_of_the_fundamental(ioc, ioc_map):
-    station, _, modes = ioc
-    assert ioc_map.nodes, "the IOC fundamental has nodes"
-    j = ioc_map.fundamental
-    assert modes.omega[j] == pytest.approx(1.0175, rel=1e-3)  # the lowest excited mode
-    scale = np.max(np.abs(ioc_map.fundamental_shape))
-    for node in ioc_map.nodes:
-        # reference: a named point placed at the node, its map built by the Ritz engine
-        st = _station_with_point(station, "probe", node.component, node.position)
-        s = build_ritz(st, "xz", 1)
-        value = (s.point("probe").translation @ modes.phi[:, j])[0]
-        carrier = st.component(node.component)
-        if hasattr(carrier, "length"):
-            # beam: linear interpolation of a cubic between samples 1/40 of the beam apart,
-            # error <= (h/L)^2 max|psi''|/8 ~ 2e-4 of the peak; 2e-3 leaves margin
-            assert abs(value) < 2e-3 * scale
-        else:
-            # rigid body: the displacement is affine, interpolation is exact to rounding
-            assert abs(value) < 1e-10 * scale
-
-
 def test_best_location_is_the_minimum_of_the_map(ioc_map):
     for measure in ("total", "elastic", "bound"):
         values = ioc_map.measure(measure)
@@ -198,44 +144,18 @@ def test_best_location_is_the_minimum_of_the_map(ioc_map):
         on_main = best_location(ioc_map, component="main", measure=measure)
         assert on_main.component == "main"
         assert on_main.peak == np.min(values[ioc_map.component == "main"])
-    with pytest.raises(InputError, match="known components"):
+    with pytest.raises(InputError, match="known components") as exc:
         best_location(ioc_map, component="nowhere")
+    assert exc.value.where == "on"
 
 
 def test_best_elastic_location_on_the_body_is_next_to_the_node(ioc_map):
     # conclusion 7: the quietest place on the main body is the fundamental's node (within
     # the densified sample spacing, 1/120 of the body)
+    ft = 0.3048
     loc = best_location(ioc_map, component="main", measure="elastic")
     node = [n for n in ioc_map.nodes if n.component == "main"][0]
-    assert abs(loc.position[2] - node.position[2]) < 2.0 * 127 * FT / 120
-
-
-def test_ritz_one_function_is_the_reports_four_coordinate_model():
-    # the report's q4 ties both half-booms; the fifth Ritz mode is the antisymmetric boom
-    # mode, which the report's model cannot represent.  Same matrices -> same eigenvalues.
-    station = load_station("ioc")
-    rm = report_matrices(station, "xz")
-    w4, _, _ = solve_dense(rm.mass, rm.stiffness, np.eye(4)[:, :2])
-    s = build_ritz(station, "xz", 1, gravity_gradient=False)
-    w5 = solve_modes(s).omega
-    for w in w4[2:]:
-        assert np.min(np.abs(w5 - w)) < 1e-9 * w
-
-
-def test_conclusion7_what_holds():
-    c = conclusion7()
-    a, b = c.orbiter, c.no_orbiter
-    # the no-orbiter fundamental has its node near the lab (z = -55 ft): within 5 ft
-    assert len(b.body_nodes_z) == 1 and abs(b.body_nodes_z[0] - (-55 * FT)) < 5 * FT
-    # with the orbiter the node is far below the lab (more than 30 ft)
-    assert abs(a.body_nodes_z[0] - (-55 * FT)) > 30 * FT
-    # the reduction at the lab is real but about one order, not the report's three
-    assert 3.0 < c.ratio_mode1 < 100.0 < c.printed_ratio_mode1
-    # with the rigid translation (f0/M: lighter station, larger) the no-orbiter lab is worse
-    assert b.rigid_translation > a.rigid_translation
-    assert c.ratio_total < 1.0
-    # the lab is farther from the centre of mass without the orbiter (the report: 59.9 ft)
-    assert c.moved > 0
+    assert abs(loc.position[2] - node.position[2]) < 2.0 * 127 * ft / 120
 
 
 def test_map_validation(ioc):
@@ -246,6 +166,8 @@ def test_map_validation(ioc):
         acceleration_map(structure, modes, "crew", "x", CREW, zeta=1.0)
     with pytest.raises(InputError, match="direction"):
         acceleration_map(structure, modes, "crew", "w", CREW)
+    with pytest.raises(InputError, match="force"):
+        acceleration_map(structure, modes, "crew", "x", object())
 
 
 def test_time_grid_path_agrees_with_exact_amax(ioc, ioc_map):
@@ -264,75 +186,64 @@ def test_time_grid_path_agrees_with_exact_amax(ioc, ioc_map):
     assert np.all(damped.total_peak <= damped.peak_bound * (1 + 1e-12))
 
 
-# --------------------------------------------------------------------------- layout
+def test_point_peak_is_the_map_at_the_point(ioc, ioc_map):
+    # one kernel: the site's peaks must be the map's at the sample on the same position (the
+    # named point's map and the sample's are the same Ritz field; same time grid)
+    _, structure, modes = ioc
+    site = point_peak(structure, modes, "lab", "crew", "x", CREW)
+    i = _sample_at(ioc_map, structure.point("lab").position)
+    for name in ("total", "elastic", "rigid", "bound"):
+        assert site.measure(name) == pytest.approx(ioc_map.measure(name)[i], rel=1e-12)
+    np.testing.assert_allclose(site.per_mode_mps2, ioc_map.per_mode[:, i], rtol=1e-12)
+    d = site.to_dict()
+    assert d["total_g"] == pytest.approx(site.total_mps2 / G0, rel=1e-15)
+    assert len(d["per_mode_g"]) == int(site.elastic.sum())
+    with pytest.raises(InputError, match="measure"):
+        site.measure("loudest")
 
 
-@pytest.fixture(scope="module")
-def small():
-    return loads_station(SMALL, filename="small.toml")
+def test_locate_is_the_one_pipeline(ioc, ioc_map):
+    # locate() = discretize (free-free) -> solve_modes -> acceleration_map -> best_location,
+    # with the model's first crew point by default
+    res = locate("ioc", on="main")
+    assert res.amap.crew_point == "crew"
+    np.testing.assert_array_equal(res.amap.total_peak, ioc_map.total_peak)
+    ref = best_location(ioc_map, component="main")
+    assert (res.best.index, res.best.peak, res.best.measure) == (ref.index, ref.peak, ref.measure)
+    assert DEFAULTS["method"] == res.amap.method == "ritz" and res.amap.plane == "xz"
+    assert res.warnings == ()
 
 
-def test_resolve_and_validate_movable(small):
-    station = load_station("ioc")
-    with pytest.raises(InputError, match="ambiguous"):
-        resolve_mass(station, "TDM 2010")
-    comp, pm = resolve_mass(station, "boom-y/TDM 2010")
-    assert comp.name == "boom-y" and pm.name == "TDM 2010"
-    with pytest.raises(InputError, match="known masses"):
-        resolve_mass(station, "Piano")
-    with pytest.raises(InputError, match="leaves"):
-        movable_masses(small, {"tip": (10.0, 70.0)})
-    with pytest.raises(InputError, match="does not contain"):
-        movable_masses(small, {"dock": (-10.0, -5.0)})
-    with pytest.raises(InputError, match="LO < HI"):
-        movable_masses(small, {"dock": (-5.0, -25.0)})
-    (mm,) = movable_masses(small, {"tip": (30.0, 60.0)})
-    assert mm.key == "keel/tip" and mm.kind == "beam" and mm.value == pytest.approx(60.0)
+def test_locate_validation():
+    with pytest.raises(InputError) as exc:
+        locate("ioc", "nowhere")
+    assert exc.value.where == "crew" and "known points" in str(exc.value)
+    with pytest.raises(InputError) as exc:
+        locate("ioc", direction="z")
+    assert exc.value.where == "direction"
+    with pytest.raises(InputError) as exc:
+        locate("ioc", measure="loudest")
+    assert exc.value.where == "measure"
+    with pytest.raises(InputError) as exc:
+        locate("ioc", method="bem")
+    assert exc.value.where == "method"
 
 
-def test_move_masses_moves_mass_and_carried_point(small):
-    (mm,) = movable_masses(small, {"lab-module": (-20.0, -4.0)})
-    moved = move_masses(small, [mm], np.array([-6.0]), carry={"lab": mm.key})
-    pm = [p for p in moved.bodies[0].masses if p.name == "lab-module"][0]
-    np.testing.assert_allclose(pm.position, [0.0, 0.0, -6.0])
-    np.testing.assert_allclose(moved.point("lab").position, [0.0, 0.0, -6.0])
-    np.testing.assert_allclose(moved.point("crew").position, [0.0, 0.0, -12.0])
-    assert small.bodies[0].masses[1].position[2] == -12.0  # the input is untouched
+def test_to_dict_to_xarray_and_plot(ioc_map):
+    from matplotlib.figure import Figure
 
+    d = ioc_map.to_dict()
+    assert len(d["samples"]) == ioc_map.n_samples
+    assert d["samples"][3]["total_peak_g"] == pytest.approx(ioc_map.total_peak[3] / G0)
+    assert d["samples"][3]["rigid_peak_g"] == pytest.approx(ioc_map.rigid_peak[3] / G0)
+    ds = ioc_map.to_xarray()
+    assert ds["position"].dims == ("sample", "axis") and ds["position"].attrs["units"] == "m"
+    assert ds["total_peak"].attrs["units"] == "m/s^2"
+    assert ds["per_mode"].dims == ("mode", "sample")
+    assert ds["omega"].attrs["units"] == "rad/s"
+    np.testing.assert_array_equal(ds["elastic_peak"].values, ioc_map.elastic_peak)
+    import matplotlib
 
-def test_optimizer_matches_brute_force_grid_in_1d(small):
-    bounds = (-20.0, -4.0)
-    res = optimize_layout(
-        small, "lab", "crew", CREW, movable={"dock": bounds}, maxiter=25, popsize=8
-    )
-    (mm,) = res.masses
-    grid = np.linspace(*bounds, 161)
-    values = np.array(
-        [
-            layout_objective(move_masses(small, [mm], np.array([x])), "lab", "crew", CREW)[0]
-            for x in grid
-        ]
-    )
-    assert bounds[0] <= res.optimal[0] <= bounds[1]
-    assert res.objective_optimal <= res.objective_initial
-    # the optimiser works in the continuum: it must do at least as well as the 0.1 m grid,
-    # up to the grid's own resolution (1e-3 relative of the grid minimum)
-    assert res.objective_optimal <= values.min() * (1 + 1e-3)
-    assert abs(res.optimal[0] - grid[np.argmin(values)]) <= 2 * (grid[1] - grid[0])
-    assert res.n_evaluations > 10
-    assert res.objective_optimal == pytest.approx(
-        layout_objective(res.station, "lab", "crew", CREW)[0], rel=1e-12
-    )
-
-
-def test_optimizer_improves_and_respects_bounds_in_2d(small):
-    movable = {"dock": (-20.0, -14.0), "tip": (40.0, 60.0)}
-    res = optimize_layout(small, "lab", "crew", CREW, movable=movable, maxiter=15, popsize=6)
-    lo = np.array([-20.0, 40.0])
-    hi = np.array([-14.0, 60.0])
-    assert np.all(res.optimal >= lo - 1e-12) and np.all(res.optimal <= hi + 1e-12)
-    assert res.objective_optimal < res.objective_initial
-    with pytest.raises(InputError, match="no movable"):
-        optimize_layout(small, "lab", "crew", CREW)
-    with pytest.raises(InputError, match="not movable"):
-        optimize_layout(small, "lab", "crew", CREW, movable=movable, carry={"lab": "hab"})
+    backend = matplotlib.get_backend()
+    fig = ioc_map.plot(best=best_location(ioc_map))
+    assert isinstance(fig, Figure) and matplotlib.get_backend() == backend
