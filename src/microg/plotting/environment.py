@@ -85,28 +85,27 @@ def plot_psd(
 
 
 def _bands_on(ax: Any, to: ThirdOctave, axes: tuple[str, ...], style: str, label: str) -> None:
-    """Band RMS per axis, micro-g; resolved bands filled, unresolved hollow."""
+    """Band RMS per axis, micro-g: a line through the centres, resolved bands filled, the
+    others hollow."""
     res = np.asarray(to.resolved, bool)
+    line, marker = style[1:] or "-", style[0]
     for name, row in zip(axes, to.rms_g, strict=False):
         y = np.maximum(row * 1e6, 1e-12)
-        (ln,) = ax.loglog(to.center_hz, y, style, ms=3, lw=0.8, label=f"{label}{name}")
+        (ln,) = ax.loglog(to.center_hz, y, line, lw=0.8, label=f"{label}{name}")
+        c = ln.get_color()
+        if np.any(res):
+            ax.plot(to.center_hz[res], y[res], marker, ms=4, color=c, label="_judged")
         if np.any(~res):
             ax.plot(
-                to.center_hz[~res],
-                y[~res],
-                "o",
-                ms=5,
-                mfc="none",
-                color=ln.get_color(),
-                label="_unresolved",
+                to.center_hz[~res], y[~res], marker, ms=4, mfc="none", color=c, label="_unjudged"
             )
 
 
 def plot_third_octave(assessment: Assessment, *, title: str = "") -> Figure:
     """1/3-octave band RMS per axis against the requirement's steps (micro-g); returns a Figure.
 
-    Hollow markers: bands not resolved by the record (not in the verdict); shaded: the range
-    the verdict covers.
+    Filled markers: bands the verdict judges; hollow: bands the record does not resolve (left
+    out of the verdict); shaded: the range the verdict covers.
     """
     to = assessment.third_octave
     fig, ax = _figure(title or f"1/3-octave band RMS vs {assessment.requirement}")

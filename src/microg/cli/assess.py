@@ -1,0 +1,273 @@
+"""``microg assess FILE``: the assessment and PIMS-style products of a measured record."""
+
+from __future__ import annotations
+
+import datetime as _dt
+import hashlib
+import sys
+from pathlib import Path
+from typing import Any
+
+import click
+
+from microg.cli.params import QuantityType
+
+__all__ = ["assess"]
+
+#: library parameter -> command-line option, for error messages
+FLAGS = {
+    "interval_s": "--interval",
+    "requirement": "--requirement",
+    "segment_s": "--segment",
+    "psd_method": "--psd",
+    "transient": "--transient",
+    "out": "--out",
+}
+
+
+@click.command()
+@click.argument("file", type=click.Path(path_type=Path))
+@click.option(
+    "--interval",
+    type=QuantityType("time", "s", minimum=0.0, strict=True),
+    default="100 s",
+    show_default=True,
+    help="Interval of the PIMS-style per-interval band RMS and percentiles.  A record "
+    "shorter than the default is taken as one interval.",
+)
+@click.option(
+    "--requirement",
+    default="iss",
+    show_default=True,
+    help="Band requirement: iss (NASA PIMS's table), ssp41000 (the continuous curve), flat.",
+)
+@click.option(
+    "--psd",
+    "psd_method",
+    type=click.Choice(["periodogram", "welch"]),
+    default="periodogram",
+    show_default=True,
+    help="Spectrum: boxcar periodogram of each interval/record, or Hann Welch (long "
+    "stationary records).",
+)
+@click.option(
+    "--segment",
+    type=QuantityType("time", "s", minimum=0.0, strict=True),
+    default=None,
+    help="Welch segment length. [default: the interval]",
+)
+@click.option(
+    "--transient",
+    default="iss",
+    show_default=True,
+    help="Transient criteria set (iss, report-1e-5g) or 'none'.",
+)
+@click.option(
+    "--sensor", default=None, help="Name of the record in the output. [default: the file's]"
+)
+@click.option("--json", "as_json", is_flag=True, help="Print the results as JSON to stdout.")
+@click.option(
+    "--out",
+    "out_dir",
+    type=click.Path(file_okay=False, path_type=Path),
+    default=None,
+    help="Also write results.json and the figures into this directory.",
+)
+def assess(
+    file: Path,
+    interval: float,
+    requirement: str,
+    psd_method: str,
+    segment: float | None,
+    transient: str,
+    sensor: str | None,
+    as_json: bool,
+    out_dir: Path | None,
+) -> None:
+    """Assess a measured acceleration record FILE against a requirement.
+
+    FILE is a PIMS/SAMS PAD data file (32-bit little-endian floats t, x, y, z in g, with its
+    .header beside it) or a CSV with units in its header (time [s], x [m/s^2], y [g], z [ug]).
+    Prints the band verdict, the PIMS-style interval statistics and the transient criteria;
+    --json prints the observations contract of `microg analyze`, keyed by sensor name.
+    """
+    from microg._io import check_writable, dumps
+    from microg.cli.analyze import flag_errors
+    from microg.environment.measured import read_measured
+
+    ctx = click.get_current_context()
+    explicit_interval = (
+        ctx.get_parameter_source("interval") is not click.core.ParameterSource.DEFAULT
+    )
+    with flag_errors(FLAGS):
+        if out_dir is not None:
+            check_writable(out_dir, "out")  # before computing anything
+        record = read_measured(file)
+        result = run_assessment(
+            record,
+            interval_s=interval,
+            explicit_interval=explicit_interval,
+            requirement=requirement,
+            psd_method=psd_method,
+            segment_s=segment,
+            transient=None if transient.strip().lower() == "none" else transient,
+            sensor=sensor,
+        )
+        payload = result["json"]
+        if out_dir is not None:
+            from microg._io import write_output_files
+
+            files = {**_figures(result), "results.json": dumps(payload)}
+            path = write_output_files(out_dir, files, where="out")
+    if as_json:
+        click.echo(dumps(payload))
+    else:
+        _summary(result)
+        if out_dir is not None:
+            click.echo(f"written to {path}")
+
+
+def run_assessment(
+    record: Any,
+    *,
+    interval_s: float = 100.0,
+    explicit_interval: bool = True,
+    requirement: str = "iss",
+    psd_method: str = "periodogram",
+    segment_s: float | None = None,
+    transient: str | None = "iss",
+    sensor: str | None = None,
+) -> dict[str, Any]:
+    """Assessment and interval products of a :class:`~microg.environment.measured.MeasuredRecord`.
+
+    Returns a dict with ``record``, ``key``, ``assessment``, ``intervals`` and ``json`` (the
+    ``--json`` document).
+    """
+    from microg import __version__
+    from microg.environment.intervals import interval_products
+    from microg.environment.metrics import assess as assess_record
+    from microg.environment.requirements import requirement as requirement_by_name
+
+    req = requirement_by_name(requirement)
+    a = assess_record(
+        record.timepts,
+        record.accel,
+        req,
+        axes=record.axes,
+        psd_method=psd_method,
+        segment_s=segment_s,
+        transient=transient,
+        transient_basis="pims",
+        cutoff_hz=record.cutoff_hz,
+        sample_rate_hz=record.sample_rate_hz,
+    )
+    warnings = list(a.warnings)
+    length = interval_s
+    if record.duration_s < interval_s and not explicit_interval:
+        length = record.duration_s
+        warnings.append(
+            f"the record ({record.duration_s:.6g} s) is shorter than the default "
+            f"{interval_s:g}-s interval: the interval products take it as one interval"
+        )
+    iv = interval_products(
+        record.timepts,
+        record.accel,
+        req,
+        axes=record.axes,
+        interval_s=length,
+        psd_method=psd_method,
+        segment_s=segment_s,
+        cutoff_hz=record.cutoff_hz,
+        sample_rate_hz=record.sample_rate_hz,
+    )
+    warnings.extend(iv.warnings)
+    key = sensor or record.key
+    data = Path(record.path)
+    try:
+        digest = hashlib.sha256(data.read_bytes()).hexdigest()
+    except OSError:
+        digest = None
+    doc = {
+        "meta": {
+            "microg_version": __version__,
+            "created_utc": _dt.datetime.now(_dt.UTC).strftime("%Y-%m-%dT%H:%M:%SZ"),
+            "command": " ".join(["microg", *sys.argv[1:]]) if sys.argv else "microg assess",
+            "file_path": str(data.resolve()),
+            "file_sha256": digest,
+        },
+        "source": record.to_dict(),
+        "requirement": req.name,
+        "requirement_source": req.source,
+        "observations": {key: a.to_dict()},
+        "intervals": {key: iv.to_dict()},
+        "complies": bool(a.complies),
+        "warnings": warnings,
+    }
+    return {"record": record, "key": key, "assessment": a, "intervals": iv, "json": doc}
+
+
+def _figures(result: dict[str, Any]) -> dict[str, bytes | str]:
+    from microg._io import safe_filenames
+    from microg.plotting.common import png_bytes
+    from microg.plotting.environment import plot_psd, plot_third_octave
+
+    a, iv, key = result["assessment"], result["intervals"], result["key"]
+    s = safe_filenames([key])[key]
+    figs = {
+        "third-octave": plot_third_octave(
+            a, title=f"1/3-octave band RMS at {key} vs {a.requirement}"
+        ),
+        "psd": plot_psd(a.spectrum, axes=a.axes, title=f"PSD at {key} ({a.spectrum.method})"),
+        "percentiles": iv.bands.plot(row="rss"),
+        "spectrogram": iv.spectrogram.plot(),
+        "cumulative-rms": iv.cumulative.plot(),
+        "band-rms-time": iv.band_limited.plot(),
+        "interval-stats": iv.stats.plot(),
+    }
+    return {f"{s}-{k}.png": png_bytes(f) for k, f in figs.items()}
+
+
+def _summary(result: dict[str, Any]) -> None:
+    from microg.units import G0
+
+    rec, a, iv, key = result["record"], result["assessment"], result["intervals"], result["key"]
+    ug = 1e6
+    cut = f", cutoff {rec.cutoff_hz:g} Hz" if rec.cutoff_hz else ""
+    click.echo(
+        f"{rec.path}: {key} ({rec.format.upper()}, {rec.sample_rate_hz:g} Hz{cut}), "
+        f"{rec.duration_s:.6g} s"
+    )
+    mean = ", ".join(f"{n} {v * ug:.4g}" for n, v in zip(a.axes, a.mean_accel_g_axis, strict=True))
+    click.echo(f"  mean (quasi-steady or sensor bias, removed before the bands): {mean} micro-g")
+    verdict = "complies" if a.complies else "DOES NOT COMPLY"
+    vr = a.verdict_range_hz
+    cover = (
+        f"bands {vr[0]:.4g}-{vr[1]:.4g} Hz judged ({int(a.third_octave.judged.sum())} of "
+        f"{a.third_octave.center_hz.size})"
+        if vr
+        else "no band judged"
+    )
+    click.echo(f"  1/3-octave vs {a.requirement}: {verdict}; {cover}")
+    wb = a.worst_band
+    if wb is not None:
+        click.echo(
+            f"  worst band {wb.center_hz:.4g} Hz ({wb.axis}): {wb.rms_g * ug:.3g} micro-g RMS, "
+            f"limit {wb.limit_g * ug:.3g}, margin {wb.margin:.3g}"
+        )
+    b = iv.bands
+    at99 = b.complies_at(99.0) if 99.0 in b.percentiles and b.resolved.any() else None
+    p99 = "" if at99 is None else f"; 99th percentile within the limit: {'yes' if at99 else 'NO'}"
+    click.echo(f"  intervals: {b.t_start_s.size} x {b.interval_s:.6g} s{p99}")
+    pb = a.integrated_pims
+    if pb is not None:
+        worst = max(pb.max_mps) / G0 * ug
+        click.echo(
+            f"  integrated acceleration (PIMS, {pb.n_blocks} blocks of {pb.window_s:g} s): "
+            f"max {worst:.3g} micro-g s"
+        )
+    if a.transient is not None:
+        tag = "" if a.transient.verified else " (unverified values: reported, not in the verdict)"
+        state = "met" if a.transient.complies else "exceeded"
+        click.echo(f"  transient criteria {a.transient.criteria}: {state}{tag}")
+    for w in result["json"]["warnings"]:
+        click.echo(f"  warning: {w}")

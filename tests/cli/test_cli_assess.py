@@ -1,0 +1,180 @@
+"""``microg assess FILE``: contract, CSV units, outputs, and bad input (one line, exit 2)."""
+
+from __future__ import annotations
+
+import json
+import struct
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from microg.cli import main
+from microg.environment.metrics import assess as assess_record
+from microg.units import G0
+
+FS = 50.0
+
+
+def _run(capsys, args: list[str]) -> tuple[int, str, str]:
+    rc = main(args)
+    out, err = capsys.readouterr()
+    return rc, out, err
+
+
+def _signal(n: int) -> np.ndarray:
+    """m/s^2: x 20 ug RMS at 2 Hz, y a 3 ug bias, z 2 ug RMS at 0.5 Hz."""
+    t = np.arange(n) / FS
+    return G0 * np.vstack(
+        [
+            20e-6 * np.sqrt(2) * np.sin(2 * np.pi * 2.0 * t),
+            np.full(n, 3e-6),
+            2e-6 * np.sqrt(2) * np.sin(2 * np.pi * 0.5 * t),
+        ]
+    )
+
+
+def _csv(path: Path, unit: str = "m/s^2", n: int = 12000, sensor: str | None = None) -> Path:
+    scale = {"m/s^2": 1.0, "g": 1 / G0, "ug": 1e6 / G0}[unit]
+    a = _signal(n) * scale
+    t = np.arange(n) / FS
+    head = f"# sensor: {sensor}\n" if sensor else ""
+    head += f"time [s], x [{unit}], y [{unit}], z [{unit}]\n"
+    body = "\n".join(
+        f"{ti:.10g},{x:.17g},{y:.17g},{z:.17g}" for ti, x, y, z in zip(t, *a, strict=True)
+    )
+    path.write_text(head + body + "\n")
+    return path
+
+
+@pytest.fixture(scope="module")
+def csv_file(tmp_path_factory) -> Path:
+    return _csv(tmp_path_factory.mktemp("m") / "rec.csv")
+
+
+def test_json_is_the_observations_contract(csv_file: Path, capsys) -> None:
+    rc, out, err = _run(capsys, ["assess", str(csv_file), "--json"])
+    assert rc == 0, err
+    d = json.loads(out)
+    assert set(d["observations"]) == {"sensor"}  # no sensor name in the file
+    o = d["observations"]["sensor"]
+    # the same keys as Assessment.to_dict() of the same record (PIMS transient basis)
+    t = np.arange(12000) / FS
+    ref = assess_record(t, _signal(12000), transient_basis="pims").to_dict()
+    assert set(o) == set(ref)
+    assert set(o["third_octave"]) == set(ref["third_octave"])
+    assert o["complies"] is ref["complies"] is True
+    assert np.allclose(o["third_octave"]["rms_g"], ref["third_octave"]["rms_g"], rtol=1e-9)
+    assert o["mean_accel_g_axis"]["y"] == pytest.approx(3e-6, rel=1e-9)
+    assert d["meta"]["file_sha256"] and d["source"]["format"] == "csv"
+    iv = d["intervals"]["sensor"]
+    assert iv["n_intervals"] == 2 and iv["interval_s"] == 100.0
+
+
+@pytest.mark.parametrize("unit", ["g", "ug"])
+def test_csv_units(tmp_path: Path, capsys, unit: str, csv_file: Path) -> None:
+    path = _csv(tmp_path / f"r_{unit}.csv", unit=unit, sensor="121f05")
+    rc, out, err = _run(capsys, ["assess", str(path), "--json", "--interval", "60 s"])
+    assert rc == 0, err
+    o = json.loads(out)["observations"]["121f05"]
+    rc, out2, _ = _run(capsys, ["assess", str(csv_file), "--json", "--interval", "60 s"])
+    base = json.loads(out2)["observations"]["sensor"]
+    # the same accelerations in another unit: the same band RMS (17 printed digits)
+    assert np.allclose(o["third_octave"]["rms_g"], base["third_octave"]["rms_g"], rtol=1e-9)
+
+
+def test_summary_and_out(tmp_path: Path, csv_file: Path, capsys) -> None:
+    out_dir = tmp_path / "res"
+    rc, out, err = _run(
+        capsys, ["assess", str(csv_file), "--out", str(out_dir), "--requirement", "ssp41000"]
+    )
+    assert rc == 0, err
+    assert "vs ssp41000: complies" in out and "judged" in out
+    names = {p.name for p in out_dir.iterdir()}
+    assert "results.json" in names
+    assert {"sensor-third-octave.png", "sensor-percentiles.png", "sensor-spectrogram.png"} <= names
+    d = json.loads((out_dir / "results.json").read_text())
+    assert d["requirement"] == "ssp41000"
+
+
+def test_welch_option(csv_file: Path, capsys) -> None:
+    rc, out, err = _run(
+        capsys, ["assess", str(csv_file), "--json", "--psd", "welch", "--segment", "50 s"]
+    )
+    assert rc == 0, err
+    d = json.loads(out)
+    assert d["observations"]["sensor"]["record"]["psd_method"] == "welch"
+
+
+def _pad(folder: Path, header_rate: str | None = "50.0", n: int = 3001) -> Path:
+    name = "2020_01_01_00_00_00.000-2020_01_01_00_01_00.000.121f02"
+    a = _signal(n) / G0
+    t = np.arange(n) / FS
+    (folder / name).write_bytes(b"".join(struct.pack("<4f", t[i], *a[:, i]) for i in range(n)))
+    rate = "" if header_rate is None else f"<SampleRate>{header_rate}</SampleRate>"
+    (folder / f"{name}.header").write_text(
+        f'<?xml version="1.0"?><sams2_accel><SensorID>121f02</SensorID>{rate}'
+        "<CutoffFreq>20.0</CutoffFreq>"
+        f'<GData file="{name}" format="binary 32 bit IEEE float little endian"/></sams2_accel>'
+    )
+    return folder / name
+
+
+def test_pad_file(tmp_path: Path, capsys) -> None:
+    path = _pad(tmp_path)
+    rc, out, err = _run(capsys, ["assess", str(path), "--json"])
+    assert rc == 0, err
+    d = json.loads(out)
+    assert set(d["observations"]) == {"121f02"}
+    assert d["source"]["sample_rate_hz"] == 50.0 and d["source"]["cutoff_hz"] == 20.0
+    # 60 s < the default 100 s: one interval, said so
+    assert d["intervals"]["121f02"]["n_intervals"] == 1
+    assert any("shorter than the default" in w for w in d["warnings"])
+
+
+def _bad(tmp_path: Path, capsys, args: list[str], needle: str) -> str:
+    out_dir = tmp_path / "never"
+    rc, out, err = _run(capsys, ["assess", *args, "--out", str(out_dir)])
+    assert rc == 2, (out, err)
+    assert err.count("\n") == 1 and "Traceback" not in err and needle in err, err
+    assert not out_dir.exists()  # nothing written
+    return err
+
+
+def test_bad_pad_input(tmp_path: Path, capsys) -> None:
+    path = _pad(tmp_path, header_rate=None)
+    err = _bad(tmp_path, capsys, [str(path)], "SampleRate")
+    assert ".header: SampleRate" in err and "add <SampleRate>" in err
+    path = _pad(tmp_path, n=1500)  # the name says 60 s, the data hold 30 s
+    err = _bad(tmp_path, capsys, [str(path)], ": length")
+    assert path.name in err and "truncated" in err
+
+
+def test_bad_csv_input(tmp_path: Path, capsys) -> None:
+    p = tmp_path / "nan.csv"
+    rows = "\n".join(f"{i / FS},0,0,{'nan' if i == 40 else 0}" for i in range(200))
+    p.write_text("time [s], x [g], y [g], z [g]\n" + rows + "\n")
+    err = _bad(tmp_path, capsys, [str(p)], "line 42")
+    assert "nan.csv" in err and "not a finite number" in err
+    p = tmp_path / "gap.csv"
+    times = [i / FS for i in range(100)] + [3.0 + i / FS for i in range(100)]
+    p.write_text("time [s], x [g]\n" + "\n".join(f"{t},0" for t in times) + "\n")
+    err = _bad(tmp_path, capsys, [str(p)], "line 102")
+    assert "uniformly" in err
+    p = tmp_path / "nounit.csv"
+    p.write_text("time, x [g]\n" + "\n".join(f"{i / FS},0" for i in range(100)) + "\n")
+    _bad(tmp_path, capsys, [str(p)], "line 1, column 1")
+    p = tmp_path / "word.csv"
+    p.write_text("time [s], x [g]\n0,0\n0.02,abc\n")
+    _bad(tmp_path, capsys, [str(p)], "line 3")
+
+
+def test_bad_options(tmp_path: Path, csv_file: Path, capsys) -> None:
+    _bad(tmp_path, capsys, [str(csv_file), "--requirement", "nasa"], "--requirement")
+    _bad(tmp_path, capsys, [str(csv_file), "--interval", "1000 s"], "--interval")
+    _bad(tmp_path, capsys, [str(tmp_path / "missing.csv")], "no such file")
+
+
+def test_out_checked_before_computing(tmp_path: Path, csv_file: Path, capsys) -> None:
+    rc, out, err = _run(capsys, ["assess", str(csv_file), "--out", "/proc/x"])
+    assert rc == 2 and err.count("\n") == 1 and "--out" in err
