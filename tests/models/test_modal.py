@@ -20,6 +20,8 @@ from microg.models.modal import (
 from microg.models.toml import load_station
 from microg.structure.discretize import discretize
 
+pytestmark = pytest.mark.nastran
+
 
 @pytest.fixture(scope="module")
 def ioc_fe():

@@ -15,6 +15,8 @@ from microg.models.nastran import Op2File, read_op2_modes
 from microg.models.toml import load_station
 from microg.structure.discretize import discretize
 
+pytestmark = pytest.mark.nastran
+
 DATA = Path(__file__).parent.parent / "data" / "nastran"
 BEAM = DATA / "beam_modes_m2.op2"
 

@@ -15,6 +15,8 @@ from microg.models.toml import load_station
 from microg.models.uff import modal_model_from_uff, write_uff_modes, write_uff_time
 from microg.structure.discretize import discretize
 
+pytestmark = pytest.mark.nastran
+
 
 @pytest.fixture(scope="module")
 def ioc():

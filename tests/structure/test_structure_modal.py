@@ -13,6 +13,8 @@ from microg.models.modal import ModalPoint, build_modal_model, parse_units
 from microg.models.toml import load_station
 from microg.structure.discretize import discretize
 
+pytestmark = pytest.mark.nastran
+
 
 @pytest.fixture(scope="module")
 def fe():

@@ -16,6 +16,8 @@ import pytest
 from microg.models.modal import parse_units, rigid_basis_at
 from microg.models.nastran import modal_model_from_op2, read_op2_modes
 
+pytestmark = pytest.mark.nastran
+
 DATA = Path(__file__).parent.parent / "data" / "nastran"
 BEAM = DATA / "beam_modes_m2.op2"
 F06 = DATA / "beam_modes.f06"
