@@ -1,0 +1,1377 @@
+"""NASTRAN bulk data (BDF/DAT) import: a deck becomes a :class:`~microg.models.graph.GraphModel`.
+
+``load_bdf(path, units="in, lbf, s")`` reads a deck with microg's own card reader (no
+pyNastran: its 1.4 releases pin numpy < 2, and the bulk data format is small and documented)
+and converts it to SI at the boundary.  The reader is checked against pyNastran's parse of
+the same decks in the ``nastran`` extra's environment (``tests/models/test_bdf.py``).
+
+**Format read.** Executive and case control up to ``BEGIN BULK`` (the case control's
+``SPC = n`` is noted), then bulk data to ``ENDDATA``: small-field (8 columns), large-field
+(``NAME*``, 16 columns, ``*`` continuations) and free-field (commas) entries; continuation
+lines (``+``/``*`` in column 1, or a blank first field); ``$`` comments; tabs as 8-column
+stops; ``INCLUDE 'file'`` anywhere (relative to the including file, nested to
+:data:`MAX_INCLUDE_DEPTH`).  Real numbers in NASTRAN's forms (``1.5``, ``1.5E-3``,
+``1.5-3``, ``1.5D-3``, ``.5``).
+
+**Cards converted:** GRID (CP, CD), CORD2R/C/S, CBAR, CBEAM, BAROR, BEAMOR, PBAR, PBARL,
+PBEAM (uniform), PBEAML (uniform), CROD, PROD, CONROD, CBUSH + PBUSH (K, B, GE), CELAS1 +
+PELAS, CELAS2, CONM2, RBE2, RBE3 (translational independent components), MAT1, PARAM
+(WTMASS, COUPMASS; K6ROT noted), SPC, SPC1, SPCADD (noted as constraints).
+
+**Cards ignored by name** (they change no stiffness or mass: loads, solution and output
+control) are counted in ``meta["ignored_cards"]`` and named in ``meta["warnings"]``; every
+other card is *unsupported* and the whole deck is refused with one :class:`InputError` listing
+each unsupported card with its count.  Nothing is dropped silently.
+
+**Units.**  NASTRAN decks declare none: ``units="LENGTH, FORCE, TIME"`` is required (e.g.
+``"in, lbf, s"``, ``"mm, N, s"``, ``"m, N, s"``); the mass unit is FORCE TIME^2 / LENGTH.  Mass
+input (densities, non-structural mass, CONM2) is multiplied by WTMASS (``PARAM,WTMASS``, or
+the ``wtmass`` argument; both given and different is an error).
+
+**Element formulation** follows NASTRAN: lumped mass unless ``PARAM,COUPMASS`` > 0; shear
+flexibility from PBAR/PBEAM K1, K2 (PBAR blank: none; PBEAM default 1.0; 0.0: none) and from
+the PBARL/PBEAML section (:data:`SECTION_SHEAR_FACTORS`); see :mod:`microg.structure.frame`.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections import Counter
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from microg.errors import InputError
+from microg.models.graph import (
+    BASIC,
+    BeamElement,
+    BeamSection,
+    ConcentratedMass,
+    Constraint,
+    CoordinateFrame,
+    GraphModel,
+    Interpolation,
+    Node,
+    RigidLink,
+    RodElement,
+    ScalarSpring,
+    Spring,
+    frame_from_points,
+    parse_components,
+    spring_axes,
+    validate_graph,
+)
+
+__all__ = [
+    "IGNORED_CARDS",
+    "MAX_CARDS",
+    "MAX_INCLUDE_DEPTH",
+    "SECTION_SHEAR_FACTORS",
+    "SUPPORTED_CARDS",
+    "Card",
+    "load_bdf",
+    "read_cards",
+    "unit_scales",
+]
+
+# fmt: off
+#: cards converted into the graph
+SUPPORTED_CARDS = (
+    "GRID", "CORD2R", "CORD2C", "CORD2S", "CBAR", "CBEAM", "BAROR", "BEAMOR", "PBAR", "PBARL",
+    "PBEAM", "PBEAML", "CROD", "PROD", "CONROD", "CBUSH", "PBUSH", "CELAS1", "CELAS2", "PELAS",
+    "CONM2", "RBE2", "RBE3", "MAT1", "PARAM", "SPC", "SPC1", "SPCADD",
+)
+# fmt: on
+# fmt: off
+#: cards read and ignored: they change neither stiffness nor mass (loads, solution control,
+#: output requests, analysis sets); counted in meta["ignored_cards"]
+IGNORED_CARDS = (
+    "ENDDATA", "EIGRL", "EIGR", "EIGB", "EIGC", "USET", "USET1", "PLOTEL", "FORCE", "FORCE1",
+    "FORCE2", "MOMENT", "MOMENT1", "MOMENT2", "LOAD", "GRAV", "RFORCE", "PLOAD", "PLOAD1",
+    "PLOAD2", "PLOAD4", "DAREA", "DLOAD", "TLOAD1", "TLOAD2", "RLOAD1", "RLOAD2", "DELAY",
+    "DPHASE", "FREQ", "FREQ1", "FREQ2", "FREQ3", "FREQ4", "FREQ5", "TABLED1", "TABLED2",
+    "TABLED3", "TABLED4", "TABDMP1", "TSTEP", "TEMP", "TEMPD", "SPCD", "NLPARM", "ASET",
+    "ASET1", "OMIT", "OMIT1", "QSET", "QSET1", "BSET", "BSET1", "CSET", "CSET1", "SUPORT",
+    "SUPORT1", "MONPNT1", "DTI",
+)
+# fmt: on
+#: the deepest nesting of INCLUDE files
+MAX_INCLUDE_DEPTH = 20
+#: the most cards read from one deck (documented limit)
+MAX_CARDS = 5_000_000
+#: transverse shear factors (K1, K2) NASTRAN gives PBARL/PBEAML sections.  ROD's 0.9 is
+#: the value Simcenter Nastran prints for the beam_modes fixture (IFP9A echo); the others
+#: are the textbook factors (thin tube 1/2, rectangle 5/6), not checked against NASTRAN
+SECTION_SHEAR_FACTORS = {"ROD": 0.9, "TUBE": 0.5, "TUBE2": 0.5, "BAR": 5.0 / 6.0}
+#: dimensions per PBARL/PBEAML type supported
+_SECTION_DIMS = {"ROD": 1, "TUBE": 2, "TUBE2": 2, "BAR": 2}
+_STRESS_SO = ("YES", "YESA", "NO")
+
+
+# --------------------------------------------------------------------------- cards
+
+
+@dataclass(frozen=True)
+class Card:
+    """One bulk data entry: its name and fields, where it was read.
+
+    ``fields[0]`` is the name; ``fields[i]`` the i-th data field counting across
+    continuations (8 per small-field line), pyNastran's numbering.  Each field is an int,
+    a float, an upper-case str or None (blank).
+    """
+
+    fields: tuple[Any, ...]
+    file: str
+    line: int
+
+    @property
+    def name(self) -> str:
+        """Card name, upper case (``GRID``)."""
+        return str(self.fields[0])
+
+    def __len__(self) -> int:
+        return len(self.fields)
+
+    def raw(self, i: int) -> Any:
+        """Field ``i`` or None beyond the end."""
+        return self.fields[i] if i < len(self.fields) else None
+
+    @property
+    def where(self) -> str:
+        ident = self.raw(1)
+        return f"{self.file}:{self.line}: {self.name}" + (f" {ident}" if ident is not None else "")
+
+    def error(self, what: str, fix: str | None = None) -> InputError:
+        return InputError(what, where=self.where, fix=fix)
+
+    def integer(self, i: int, label: str, default: Any = ...) -> int:
+        v = self.raw(i)
+        if v is None:
+            if default is ...:
+                raise self.error(f"field {i + 1} ({label}) is blank", f"give {label}")
+            return default
+        if not isinstance(v, int):
+            raise self.error(f"field {i + 1} ({label}) must be an integer, got {v!r}")
+        return v
+
+    def real(self, i: int, label: str, default: Any = ...) -> float:
+        v = self.raw(i)
+        if v is None:
+            if default is ...:
+                raise self.error(f"field {i + 1} ({label}) is blank", f"give {label}")
+            return default
+        if isinstance(v, str):
+            raise self.error(f"field {i + 1} ({label}) must be a number, got {v!r}")
+        return float(v)
+
+    def text(self, i: int, label: str, default: Any = ...) -> str:
+        v = self.raw(i)
+        if v is None:
+            if default is ...:
+                raise self.error(f"field {i + 1} ({label}) is blank", f"give {label}")
+            return default
+        return str(v)
+
+
+_INT = re.compile(r"[+-]?\d+$")
+_REAL = re.compile(r"([+-]?(?:\d+\.\d*|\.\d+|\d+))(?:([EeDd])?([+-]?\d+))?$")
+
+
+def _value(text: str) -> Any:
+    """A field's value: None, int, float or an upper-case string."""
+    s = text.strip()
+    if not s:
+        return None
+    if _INT.match(s):
+        return int(s)
+    m = _REAL.match(s)
+    if m and ("." in m.group(1) or m.group(2)):
+        mant, letter, exp = m.group(1), m.group(2), m.group(3)
+        if exp is not None and letter is None and not exp.startswith(("+", "-")):
+            return s.upper()  # "1.5 3" and the like: not a number
+        try:
+            v = float(mant) * 10.0 ** int(exp) if exp is not None else float(mant)
+        except OverflowError:
+            return s.upper()
+        return v if math.isfinite(v) else s.upper()
+    return s.upper()
+
+
+@dataclass
+class _Line:
+    text: str
+    file: str
+    number: int
+
+
+def _read_lines(path: Path, shown: str, depth: int, stack: tuple[Path, ...]) -> Iterator[_Line]:
+    """Lines of ``path`` with INCLUDEs expanded (file name and line number kept)."""
+    try:
+        raw = path.read_bytes()
+    except OSError as exc:
+        raise InputError(f"cannot read the file: {exc.strerror or exc}", where=shown) from None
+    text = raw.decode("latin-1")
+    lines = text.splitlines()
+    i = 0
+    while i < len(lines):
+        line = lines[i].expandtabs(8)
+        number = i + 1
+        i += 1
+        head = line.lstrip()[:7].upper()
+        if head == "INCLUDE" and not line.lstrip().startswith("$"):
+            spec = line.lstrip()[7:]
+            while spec.count("'") == 1 and i < len(lines):  # a quoted path continued
+                spec += lines[i].strip()
+                i += 1
+            m = re.match(r"\s*'([^']*)'\s*(\$.*)?$", spec) or re.match(r"\s*(\S+)\s*(\$.*)?$", spec)
+            if not m:
+                raise InputError(
+                    "INCLUDE needs a file name",
+                    where=f"{shown}:{number}",
+                    fix="write INCLUDE 'file.bdf'",
+                )
+            name = m.group(1).strip()
+            target = Path(name) if Path(name).is_absolute() else path.parent / name
+            target_shown = str(Path(shown).parent / name) if not Path(name).is_absolute() else name
+            if depth >= MAX_INCLUDE_DEPTH or target.resolve() in stack:
+                raise InputError(
+                    f"INCLUDE {name!r} nests deeper than {MAX_INCLUDE_DEPTH} or includes itself",
+                    where=f"{shown}:{number}",
+                    fix="remove the circular INCLUDE",
+                )
+            if not target.is_file():
+                raise InputError(
+                    f"INCLUDE {name!r}: file not found",
+                    where=f"{shown}:{number}",
+                    fix="give the path relative to the including file",
+                )
+            yield from _read_lines(target, target_shown, depth + 1, (*stack, target.resolve()))
+            continue
+        yield _Line(line, shown, number)
+
+
+def _fields_of(line: str, first: bool) -> tuple[str | None, list[str], bool]:
+    """(name or None for a continuation, data fields, large-field) of one physical line."""
+    if "," in line:
+        parts = line.split(",")
+        head = parts[0].strip()
+        large = head.endswith("*")
+        data = parts[1:]
+        per = 4 if large else 8
+        if len(data) > per:  # the field after the data is a continuation marker
+            data = data[:per] + data[per + 1 :]
+        return (None if not first else head.rstrip("*")), data, large
+    head = line[:8]
+    large = head.strip().endswith("*")
+    if large:
+        data = [line[8 + 16 * k : 24 + 16 * k] for k in range(4)]
+    else:
+        data = [line[8 + 8 * k : 16 + 8 * k] for k in range(8)]
+    return (None if not first else head.strip().rstrip("*")), data, large
+
+
+def _is_continuation(line: str) -> bool:
+    s = line.rstrip()
+    if not s:
+        return False
+    if s[0] in "+*" or s.startswith(","):
+        return True
+    if "," in s:
+        return not s.split(",")[0].strip()
+    return not line[:8].strip()
+
+
+def read_cards(path: str | Path) -> tuple[list[Card], list[str]]:
+    """Bulk data cards of a deck and its case control lines.
+
+    Parameters
+    ----------
+    path : str or Path
+        The deck (``.bdf``, ``.dat``, ``.blk``, ``.nas``); INCLUDEs relative to it.
+
+    Returns
+    -------
+    cards : list of Card
+    case_control : list of str
+        Upper-case case control lines (empty for a bulk-only file).
+    """
+    p = Path(path)
+    shown = str(path)
+    if not p.is_file():
+        raise InputError("file not found", where=shown, fix="check the path")
+    lines = list(_read_lines(p, shown, 0, (p.resolve(),)))
+    begin = next(
+        (k for k, ln in enumerate(lines) if re.match(r"\s*BEGIN\s+(BULK|SUPER)", ln.text, re.I)),
+        None,
+    )
+    case: list[str] = []
+    if begin is not None:
+        if re.match(r"\s*BEGIN\s+SUPER", lines[begin].text, re.I):
+            raise InputError(
+                "superelement bulk data (BEGIN SUPER) is not supported",
+                where=f"{lines[begin].file}:{lines[begin].number}",
+                fix="give the residual structure only",
+            )
+        cend = next(
+            (k for k, ln in enumerate(lines[:begin]) if re.match(r"\s*CEND\b", ln.text, re.I)), -1
+        )
+        case = [ln.text.split("$")[0].strip().upper() for ln in lines[cend + 1 : begin]]
+        lines = lines[begin + 1 :]
+    cards: list[Card] = []
+    cur: list[Any] | None = None
+    cur_at: tuple[str, int] = ("", 0)
+    for ln in lines:
+        text = ln.text.split("$", 1)[0] if "$" in ln.text else ln.text
+        if not text.strip():
+            continue
+        if re.match(r"\s*ENDDATA\b", text, re.I):
+            break
+        if cur is not None and _is_continuation(text):
+            if "," in text:
+                parts = text.split(",")
+                large = parts[0].strip().startswith("*")
+                data = parts[1:]
+                per = 4 if large else 8
+                if len(data) > per:
+                    data = data[:per] + data[per + 1 :]
+            else:
+                large = text.startswith("*")
+                data = (
+                    [text[8 + 16 * k : 24 + 16 * k] for k in range(4)]
+                    if large
+                    else [text[8 + 8 * k : 16 + 8 * k] for k in range(8)]
+                )
+            cur.extend(_value(f) for f in data)
+            continue
+        if cur is not None:
+            cards.append(_card(cur, cur_at))
+        if len(cards) >= MAX_CARDS:
+            raise InputError(f"more than {MAX_CARDS} cards", where=shown, fix="split the model")
+        name, data, _ = _fields_of(text, True)
+        assert name is not None
+        cur = [name.strip().upper(), *(_value(f) for f in data)]
+        cur_at = (ln.file, ln.number)
+    if cur is not None:
+        cards.append(_card(cur, cur_at))
+    return cards, case
+
+
+def _card(fields: list[Any], at: tuple[str, int]) -> Card:
+    while len(fields) > 1 and fields[-1] is None:
+        fields.pop()
+    return Card(tuple(fields), at[0], at[1])
+
+
+# --------------------------------------------------------------------------- units
+
+
+@dataclass(frozen=True)
+class _Scales:
+    length: float
+    force: float
+    time: float
+
+    @property
+    def mass(self) -> float:
+        return self.force * self.time**2 / self.length
+
+
+def unit_scales(units: str | None, *, where: str = "units") -> tuple[float, float, float]:
+    """SI values of the deck's length, force and time units from ``"LENGTH, FORCE, TIME"``.
+
+    ``"in, lbf, s"`` -> (0.0254, 4.448..., 1.0).  A missing declaration is an error (NASTRAN
+    files declare none); each unit is checked for its dimension.
+    """
+    from microg.units import parse_quantity
+
+    if units is None or not str(units).strip():
+        raise InputError(
+            "NASTRAN files declare no units and none were given",
+            where=where,
+            fix='state them as "LENGTH, FORCE, TIME", e.g. units="in, lbf, s" '
+            "(and wtmass if the deck's masses are weights)",
+        )
+    parts = [u.strip() for u in str(units).split(",")]
+    if len(parts) != 3 or not all(parts):
+        raise InputError(
+            f"expected three units LENGTH, FORCE, TIME, got {units!r}",
+            where=where,
+            fix='write e.g. "in, lbf, s" or "mm, N, s"',
+        )
+    dims = ("length", "force", "time")
+    out = tuple(parse_quantity(f"1 {u}", d, where=where) for u, d in zip(parts, dims, strict=True))
+    return out[0], out[1], out[2]
+
+
+# --------------------------------------------------------------------------- sections
+
+
+def _section_values(
+    kind: str, dims: list[float], card: Card
+) -> tuple[float, float, float, float, float]:
+    """A, I1, I2, J and the shear factor of a PBARL/PBEAML section (deck units)."""
+    if any(not d > 0 for d in dims):
+        raise card.error(f"section {kind} dimensions must be > 0, got {dims}")
+    k = SECTION_SHEAR_FACTORS[kind]
+    if kind == "ROD":
+        r = dims[0]
+        a = math.pi * r**2
+        i = math.pi * r**4 / 4.0
+        return a, i, i, 2.0 * i, k
+    if kind in ("TUBE", "TUBE2"):
+        ro = dims[0]
+        ri = dims[1] if kind == "TUBE" else dims[0] - dims[1]
+        if not 0 <= ri < ro:
+            raise card.error(f"{kind} needs an inner radius between 0 and the outer, got {dims}")
+        a = math.pi * (ro**2 - ri**2)
+        i = math.pi * (ro**4 - ri**4) / 4.0
+        return a, i, i, 2.0 * i, k
+    # BAR: DIM1 x DIM2, I1 = DIM1 DIM2^3 / 12 (pyNastran's convention), Roark's J
+    b, h = dims
+    long_, short = max(b, h), min(b, h)
+    j = long_ * short**3 * (1.0 / 3.0 - 0.21 * short / long_ * (1.0 - short**4 / (12.0 * long_**4)))
+    return b * h, b * h**3 / 12.0, h * b**3 / 12.0, j, k
+
+
+# --------------------------------------------------------------------------- deck -> graph
+
+
+@dataclass
+class _Material:
+    e: float
+    g: float
+    nu: float
+    rho: float
+    ge: float
+    card: Card
+
+
+@dataclass
+class _BeamProp:
+    a: float
+    i1: float
+    i2: float
+    i12: float
+    j: float
+    nsm: float
+    k1: float | None
+    k2: float | None
+    mid: int
+    card: Card
+
+
+class _Deck:
+    """Converts cards to a GraphModel (private)."""
+
+    def __init__(
+        self,
+        cards: list[Card],
+        case: list[str],
+        path: str,
+        sc: _Scales,
+        wtmass: float | None,
+        spc: int | None,
+    ):
+        self.cards = cards
+        self.case = case
+        self.path = path
+        self.sc = sc
+        self.user_wtmass = wtmass
+        self.user_spc = spc
+        self.warnings: list[str] = []
+        self.origin: dict[str, Card] = {}
+
+    def by_id(self, names: tuple[str, ...], what: str) -> dict[int, Card]:
+        out: dict[int, Card] = {}
+        for c in self.cards:
+            if c.name in names:
+                i = c.integer(1, f"{what} id")
+                if i in out:
+                    raise c.error(f"duplicate {what} id {i} (also at {out[i].file}:{out[i].line})")
+                out[i] = c
+        return out
+
+    def build(self) -> GraphModel:
+        counts = Counter(c.name for c in self.cards)
+        unsupported = {
+            k: v for k, v in counts.items() if k not in SUPPORTED_CARDS and k not in IGNORED_CARDS
+        }
+        if unsupported:
+            listing = ", ".join(f"{k} ({v})" for k, v in sorted(unsupported.items()))
+            raise InputError(
+                f"unsupported cards: {listing}",
+                where=self.path,
+                fix="microg's frame elements read "
+                + " ".join(SUPPORTED_CARDS)
+                + "; remove the others or replace them by supported elements",
+            )
+        ignored = {k: v for k, v in counts.items() if k in IGNORED_CARDS and k != "ENDDATA"}
+        if ignored:
+            self.warnings.append(
+                "cards ignored (no stiffness or mass): "
+                + ", ".join(f"{k} ({v})" for k, v in sorted(ignored.items()))
+            )
+        params = self.params()
+        wt = self.wtmass(params)
+        coupmass = params.get("COUPMASS")
+        lumped = not (
+            coupmass is not None
+            and isinstance(coupmass.raw(2), int | float)
+            and coupmass.raw(2) > 0
+        )
+        if "K6ROT" in params:
+            self.warnings.append(
+                "PARAM K6ROT noted: it stiffens shell drilling rotations only; no shells here"
+            )
+        frames = self.frames()
+        nodes, grid_pos, grid_axes = self.grids(frames)
+        mats = self.materials()
+        beam_props = self.beam_properties(mats)
+        beams = self.beams(beam_props, mats, grid_pos, grid_axes, wt)
+        rods = self.rods(mats, grid_pos, wt)
+        springs = self.bushes(grid_pos, grid_axes, frames)
+        scalars = self.scalar_springs()
+        masses = self.conm2(grid_pos, frames, wt)
+        links, interps = self.rigid(grid_pos)
+        constraints = self.constraints(grid_pos)
+        for ps_node, comps in self.grid_ps:
+            constraints.append(Constraint(ps_node, comps))
+        ignored_params = sorted(k for k in params if k not in ("WTMASS", "COUPMASS"))
+        meta = {
+            "format": "nastran-bdf",
+            "units": {"length_m": self.sc.length, "force_N": self.sc.force, "time_s": self.sc.time},
+            "wtmass": wt,
+            "mass_formulation": "lumped" if lumped else "consistent",
+            "ignored_cards": ignored,
+            "params_ignored": ignored_params,
+            "card_counts": dict(counts),
+            "spc_sets": self.spc_sets,
+            "warnings": tuple(self.warnings),
+        }
+        graph = GraphModel(
+            name=Path(self.path).stem,
+            nodes=tuple(nodes),
+            beams=tuple(beams),
+            rods=tuple(rods),
+            springs=tuple(springs),
+            scalar_springs=tuple(scalars),
+            masses=tuple(masses),
+            rigid_links=tuple(links),
+            interpolations=tuple(interps),
+            frames=tuple(f for k, f in frames.items() if k != 0),
+            mass_formulation="lumped" if lumped else "consistent",
+            constraints=tuple(constraints),
+            source=self.path,
+            meta=meta,
+        )
+        try:
+            validate_graph(graph)
+        except InputError as exc:
+            where = exc.where or ""
+            card = self.origin.get(where.split(": ", 1)[1]) if ": " in where else None
+            if card is not None:
+                raise InputError(exc.what, where=card.where, fix=exc.fix) from None
+            raise
+        return graph
+
+    # ---- parameters and units
+
+    def params(self) -> dict[str, Card]:
+        out: dict[str, Card] = {}
+        for c in self.cards:
+            if c.name == "PARAM":
+                out[c.text(1, "parameter name").upper()] = c
+        return out
+
+    def wtmass(self, params: dict[str, Card]) -> float:
+        c = params.get("WTMASS")
+        deck = c.real(2, "WTMASS") if c is not None else None
+        if deck is not None and not deck > 0:
+            assert c is not None
+            raise c.error(f"WTMASS must be > 0, got {deck}")
+        if self.user_wtmass is not None:
+            if not (isinstance(self.user_wtmass, int | float) and self.user_wtmass > 0):
+                raise InputError(f"wtmass must be > 0, got {self.user_wtmass!r}", where="wtmass")
+            if deck is not None and not math.isclose(deck, self.user_wtmass, rel_tol=1e-9):
+                assert c is not None
+                raise InputError(
+                    f"the deck's PARAM WTMASS {deck:g} contradicts wtmass = {self.user_wtmass:g}",
+                    where=c.where,
+                    fix="give the deck's value or omit wtmass",
+                )
+            return float(self.user_wtmass)
+        return 1.0 if deck is None else deck
+
+    # ---- geometry
+
+    def frames(self) -> dict[int, CoordinateFrame]:
+        raw = self.by_id(("CORD2R", "CORD2C", "CORD2S"), "coordinate system")
+        if 0 in raw:
+            raise raw[0].error("coordinate system 0 is the basic system", "use another id")
+        kinds = {"CORD2R": "rectangular", "CORD2C": "cylindrical", "CORD2S": "spherical"}
+        out: dict[int, CoordinateFrame] = {0: BASIC}
+        pending = dict(raw)
+        while pending:
+            done = []
+            for cid, c in pending.items():
+                rid = c.integer(2, "RID", 0)
+                if rid not in out:
+                    if rid not in raw:
+                        raise c.error(
+                            f"reference system {rid} is not defined", "define it or use RID 0"
+                        )
+                    continue
+                ref = out[rid]
+                pts = []
+                for k in (3, 6, 9):
+                    v = np.array(
+                        [
+                            c.real(k + m, f"point {'ABC'[(k - 3) // 3]}{m + 1}", 0.0)
+                            for m in range(3)
+                        ]
+                    )
+                    pts.append(ref.to_basic(self._coords(ref.kind, v)))
+                out[cid] = frame_from_points(f"cs:{cid}", kinds[c.name], *pts, where=c.where)
+                done.append(cid)
+            if not done:
+                c = next(iter(pending.values()))
+                raise c.error(
+                    "coordinate systems reference each other in a cycle", "break the RID chain"
+                )
+            for cid in done:
+                del pending[cid]
+        return out
+
+    def _coords(self, kind: str, v: np.ndarray) -> np.ndarray:
+        """Deck coordinates in a system of ``kind`` -> SI (lengths scaled, degrees to rad)."""
+        L = self.sc.length
+        if kind == "rectangular":
+            return v * L
+        if kind == "cylindrical":
+            return np.array([v[0] * L, math.radians(v[1]), v[2] * L])
+        return np.array([v[0] * L, math.radians(v[1]), math.radians(v[2])])
+
+    def frame(self, frames: dict[int, CoordinateFrame], cid: int, c: Card) -> CoordinateFrame:
+        if cid not in frames:
+            raise c.error(f"coordinate system {cid} is not defined", "add its CORD2R/C/S card")
+        return frames[cid]
+
+    def grids(
+        self, frames: dict[int, CoordinateFrame]
+    ) -> tuple[list[Node], dict[int, np.ndarray], dict[int, np.ndarray]]:
+        grids = self.by_id(("GRID",), "grid")
+        self.grid_cards = grids
+        if not grids:
+            raise InputError(
+                "the deck has no GRID", where=self.path, fix="give the bulk data with its grids"
+            )
+        nodes: list[Node] = []
+        pos: dict[int, np.ndarray] = {}
+        axes: dict[int, np.ndarray] = {}
+        self.grid_ps: list[tuple[str, str]] = []
+        for gid, c in sorted(grids.items()):
+            cp = c.integer(2, "CP", 0)
+            cd = c.integer(6, "CD", 0)
+            if c.raw(8) not in (None, 0):
+                raise c.error(
+                    "superelement grids (SEID) are not supported", "give the residual structure"
+                )
+            if cd == -1:
+                raise c.error("fluid grids (CD = -1) are not supported")
+            fr = self.frame(frames, cp, c)
+            x = np.array([c.real(3 + k, f"X{k + 1}", 0.0) for k in range(3)])
+            p = fr.to_basic(self._coords(fr.kind, x))
+            fd = self.frame(frames, cd, c)
+            ax = fd.axes_at(p)
+            name = f"grid:{gid}"
+            nodes.append(Node(name, p, ax, "basic" if cd == 0 else f"cs:{cd}"))
+            pos[gid] = p
+            axes[gid] = ax
+            ps = c.raw(7)
+            if ps not in (None, 0):
+                self.grid_ps.append((name, self.components(ps, c, "PS")))
+            self.origin[name] = c
+        return nodes, pos, axes
+
+    def components(self, value: Any, c: Card, label: str, allowed: str = "123456") -> str:
+        try:
+            return parse_components(value, where=c.where, allowed=allowed)
+        except InputError as exc:
+            raise c.error(f"{label}: {exc.what}", exc.fix) from None
+
+    def grid(self, gid: Any, c: Card, pos: dict[int, np.ndarray], label: str) -> str:
+        if not isinstance(gid, int) or gid not in pos:
+            known = sorted(pos)
+            near = sorted(known, key=lambda k: abs(k - gid) if isinstance(gid, int) else k)[:5]
+            raise c.error(
+                f"{label} grid {gid} is not defined",
+                f"add GRID {gid} or correct the id (nearest: {', '.join(map(str, near))})",
+            )
+        return f"grid:{gid}"
+
+    # ---- materials and properties
+
+    def materials(self) -> dict[int, _Material]:
+        out: dict[int, _Material] = {}
+        sc = self.sc
+        for mid, c in self.by_id(("MAT1",), "material").items():
+            e = c.real(2, "E", None)
+            g = c.real(3, "G", None)
+            nu = c.real(4, "NU", None)
+            if not e and not g:
+                raise c.error("E and G are both blank or zero", "give E (and NU or G)")
+            if e and g is None:
+                g = e / (2.0 * (1.0 + nu)) if nu is not None else 0.0
+            elif g and e is None:
+                e = 2.0 * (1.0 + nu) * g if nu is not None else 0.0
+            if nu is None:
+                nu = e / (2.0 * g) - 1.0 if e and g else 0.0
+            rho = c.real(5, "RHO", 0.0)
+            ge = c.real(8, "GE", 0.0)
+            assert e is not None and g is not None
+            if e < 0 or g < 0 or rho < 0:
+                raise c.error("E, G and RHO must be >= 0")
+            out[mid] = _Material(
+                e * sc.force / sc.length**2, g * sc.force / sc.length**2, nu, rho, ge, c
+            )
+        return out
+
+    def material(self, mats: dict[int, _Material], mid: int, c: Card) -> _Material:
+        if mid not in mats:
+            raise c.error(
+                f"material {mid} (MAT1) is not defined", "add the MAT1 card or correct MID"
+            )
+        return mats[mid]
+
+    def beam_properties(self, mats: dict[int, _Material]) -> dict[int, _BeamProp]:
+        out: dict[int, _BeamProp] = {}
+        for pid, c in self.by_id(("PBAR", "PBARL", "PBEAM", "PBEAML"), "beam property").items():
+            mid = c.integer(2, "MID")
+            if c.name == "PBAR":
+                k1 = c.real(17, "K1", None)
+                k2 = c.real(18, "K2", None)
+                prop = _BeamProp(
+                    c.real(3, "A", 0.0),
+                    c.real(4, "I1", 0.0),
+                    c.real(5, "I2", 0.0),
+                    c.real(19, "I12", 0.0),
+                    c.real(6, "J", 0.0),
+                    c.real(7, "NSM", 0.0),
+                    k1 if k1 else None,
+                    k2 if k2 else None,
+                    mid,
+                    c,
+                )
+            elif c.name == "PBEAM":
+                prop = self.pbeam(c, mid)
+            else:
+                prop = self.pbarl(c, mid)
+            out[pid] = prop
+        return out
+
+    def pbarl(self, c: Card, mid: int) -> _BeamProp:
+        group = c.text(3, "GROUP", "MSCBML0")
+        kind = c.text(4, "TYPE")
+        if group != "MSCBML0":
+            raise c.error(f"section group {group!r} is not supported", "use the MSCBML0 library")
+        if kind not in _SECTION_DIMS:
+            raise c.error(
+                f"section type {kind!r} is not supported (microg knows {', '.join(_SECTION_DIMS)})",
+                "give the section as PBAR/PBEAM with A, I1, I2, J, K1, K2",
+            )
+        n = _SECTION_DIMS[kind]
+        dims = [c.real(9 + k, f"DIM{k + 1}") for k in range(n)]
+        nsm = c.real(9 + n, "NSM", 0.0)
+        if c.name == "PBEAML":
+            i = 10 + n
+            while i < len(c):  # further stations: SO, X/XB, dims, NSM; uniform only
+                sd = [c.real(i + 2 + k, f"DIM{k + 1}", dims[k]) for k in range(n)]
+                snsm = c.real(i + 2 + n, "NSM", nsm)
+                if not np.allclose(sd, dims, rtol=1e-9) or not math.isclose(
+                    snsm, nsm, rel_tol=1e-9
+                ):
+                    raise c.error(
+                        "tapered sections are not supported", "give a uniform section (one station)"
+                    )
+                i += 3 + n
+        elif len(c) > 10 + n:
+            raise c.error("has fields beyond DIMs and NSM")
+        a, i1, i2, j, k = _section_values(kind, dims, c)
+        return _BeamProp(a, i1, i2, 0.0, j, nsm, k, k, mid, c)
+
+    def pbeam(self, c: Card, mid: int) -> _BeamProp:
+        a = c.real(3, "A")
+        i1 = c.real(4, "I1", 0.0)
+        i2 = c.real(5, "I2", 0.0)
+        i12 = c.real(6, "I12", 0.0)
+        j = c.real(7, "J", 0.0)
+        nsm = c.real(8, "NSM", 0.0)
+        i = 9
+        if i < len(c) and not isinstance(c.raw(9), str):
+            i = 17  # stress recovery points at end A
+        end_a = (a, i1, i2, i12, j, nsm)
+        while i < len(c) and isinstance(c.raw(i), str):
+            so = c.text(i, "SO")
+            if so not in _STRESS_SO:
+                raise c.error(f"SO {so!r} must be YES, YESA or NO")
+            vals = tuple(c.real(i + 2 + k, "station value", end_a[k]) for k in range(6))
+            if not np.allclose(vals, end_a, rtol=1e-9, atol=0.0):
+                raise c.error(
+                    "tapered beams are not supported", "give a uniform PBEAM (end B = end A)"
+                )
+            i += 16 if so == "YES" else 8
+        k1 = c.real(i, "K1", 1.0)
+        k2 = c.real(i + 1, "K2", 1.0)
+        extra = [c.real(i + k, "field", 0.0) for k in range(4, 16)]
+        nsi = extra[0:2]
+        cw = extra[2:4]
+        mn = extra[4:12]
+        if any(mn) or any(nsi):
+            raise c.error(
+                "non-structural mass inertia or offsets (NSI, M1-N2) are not supported",
+                "remove them or model the offset mass with CONM2",
+            )
+        if any(cw):
+            self.warnings.append(f"{c.where}: warping coefficients CW ignored (no warping DOFs)")
+        return _BeamProp(a, i1, i2, i12, j, nsm, k1 or None, k2 or None, mid, c)
+
+    def section(self, prop: _BeamProp, mat: _Material, wt: float) -> BeamSection:
+        sc = self.sc
+        L2, L4 = sc.length**2, sc.length**4
+        a, i1, i2, j = prop.a * L2, prop.i1 * L4, prop.i2 * L4, prop.j * L4
+        c = prop.card
+        if not (a > 0 and i1 > 0 and i2 > 0 and j > 0):
+            raise c.error(
+                "A, I1, I2 and J must be > 0 for a beam, got "
+                f"{prop.a}, {prop.i1}, {prop.i2}, {prop.j}"
+            )
+        if mat.g <= 0:
+            raise mat.card.error(
+                "G is zero: the beams using it have no torsional stiffness", "give G or NU"
+            )
+        rho = mat.rho * wt * sc.mass / sc.length**3
+        nsm = prop.nsm * wt * sc.mass / sc.length
+        mpl = rho * a + nsm
+        shear = [None if k is None else k * mat.g * a for k in (prop.k1, prop.k2)]
+        return BeamSection(
+            f"{c.name.lower()}:{c.raw(1)}",
+            mat.e * a,
+            mat.e * i2,
+            mat.e * i1,
+            mat.g * j,
+            mpl,
+            rho * (i1 + i2),
+            shear[0],
+            shear[1],
+            0.0,
+            0.0,
+            mat.e * prop.i12 * L4,
+        )
+
+    # ---- elements
+
+    def orientation(
+        self,
+        c: Card,
+        defaults: Card | None,
+        pos: dict[int, np.ndarray],
+        axes: dict[int, np.ndarray],
+        ga: int,
+    ) -> tuple[np.ndarray, str]:
+        """Orientation vector (basic) and OFFT of a CBAR/CBEAM (BAROR/BEAMOR defaults)."""
+        src = c
+        x1 = c.raw(5)
+        if x1 is None and defaults is not None:
+            src = defaults
+            x1 = defaults.raw(5)
+        offt = c.raw(8)
+        if isinstance(offt, float):  # CBEAM BIT (p-elements only)
+            self.warnings.append(f"{c.where}: BIT ignored")
+            offt = None
+        if offt is None and defaults is not None and isinstance(defaults.raw(8), str):
+            offt = defaults.raw(8)
+        offt = str(offt or "GGG")
+        if len(offt) != 3 or offt[0] not in "GB" or offt[1] not in "GO" or offt[2] not in "GO":
+            raise c.error(
+                f"OFFT {offt!r} is not valid", "use GGG, BGG, GGO, ... (offsets in O not supported)"
+            )
+        if "O" in offt[1:]:
+            raise c.error(
+                f"OFFT {offt!r}: offsets in the element system are not supported",
+                "give offsets in G",
+            )
+        if x1 is None:
+            raise c.error(
+                "has no orientation vector (X1-X3 or G0) and no BAROR/BEAMOR default",
+                "give X1, X2, X3 or G0",
+            )
+        if isinstance(x1, int):
+            g0 = self.grid(x1, src, pos, "G0")
+            del g0
+            return pos[x1] - pos[ga], offt
+        v = np.array([src.real(5 + k, f"X{k + 1}", 0.0) for k in range(3)])
+        if offt[0] == "G":
+            v = v @ axes[ga]
+        return v, offt
+
+    def beams(
+        self,
+        props: dict[int, _BeamProp],
+        mats: dict[int, _Material],
+        pos: dict[int, np.ndarray],
+        axes: dict[int, np.ndarray],
+        wt: float,
+    ) -> list[BeamElement]:
+        out: list[BeamElement] = []
+        sections: dict[int, BeamSection] = {}
+        orient = {
+            n: next((c for c in self.cards if c.name == n), None) for n in ("BAROR", "BEAMOR")
+        }
+        for name in ("CBAR", "CBEAM"):
+            defaults = orient["BAROR" if name == "CBAR" else "BEAMOR"]
+            for eid, c in self.by_id((name,), "element").items():
+                pid = c.integer(2, "PID", None)
+                if pid is None and defaults is not None:
+                    pid = defaults.integer(2, "PID", None)
+                pid = eid if pid is None else pid
+                if pid not in props:
+                    raise c.error(
+                        f"property {pid} ({'PBAR/PBARL' if name == 'CBAR' else 'PBEAM/PBEAML'})"
+                        " is not defined",
+                        "add the property card or correct PID",
+                    )
+                prop = props[pid]
+                if name == "CBAR" and prop.card.name not in ("PBAR", "PBARL"):
+                    raise c.error(
+                        f"property {pid} is a {prop.card.name}; a CBAR needs a PBAR or PBARL"
+                    )
+                if name == "CBEAM" and prop.card.name not in ("PBEAM", "PBEAML"):
+                    raise c.error(
+                        f"property {pid} is a {prop.card.name}; a CBEAM needs a PBEAM or PBEAML"
+                    )
+                if pid not in sections:
+                    sections[pid] = self.section(prop, self.material(mats, prop.mid, prop.card), wt)
+                ga_id, gb_id = c.raw(3), c.raw(4)
+                ga = self.grid(ga_id, c, pos, "GA")
+                gb = self.grid(gb_id, c, pos, "GB")
+                if ga_id == gb_id:
+                    raise c.error("GA and GB are the same grid", "connect two distinct grids")
+                v, offt = self.orientation(c, defaults, pos, axes, ga_id)
+                wa = (
+                    np.array([c.real(11 + k, f"W{k + 1}A", 0.0) for k in range(3)]) * self.sc.length
+                )
+                wb = (
+                    np.array([c.real(14 + k, f"W{k + 1}B", 0.0) for k in range(3)]) * self.sc.length
+                )
+                wa = wa @ axes[ga_id]
+                wb = wb @ axes[gb_id]
+                releases = tuple(
+                    "" if c.raw(k) in (None, 0) else self.components(c.raw(k), c, lab)
+                    for k, lab in ((9, "PA"), (10, "PB"))
+                )
+                if name == "CBEAM" and (c.raw(17) or c.raw(18)):
+                    raise c.error("warping scalar points SA/SB are not supported")
+                ename = f"{name.lower()}:{eid}"
+                self.origin[ename] = c
+                end_a, end_b = pos[ga_id] + wa, pos[gb_id] + wb
+                length = float(np.linalg.norm(end_b - end_a))
+                if length <= 1e-9 * max(
+                    float(np.max(np.abs(np.concatenate([end_a, end_b])))), 1e-300
+                ):
+                    raise c.error(
+                        "has zero length (its ends coincide)",
+                        "connect distinct points, or use a CBUSH or RBE2",
+                    )
+                out.append(
+                    BeamElement(
+                        ename,
+                        (ga, gb),
+                        sections[pid],
+                        v,
+                        np.stack([wa, wb]),
+                        "bar" if name == "CBAR" else "beam",
+                        (releases[0], releases[1]),
+                    )
+                )
+        return out
+
+    def rods(
+        self, mats: dict[int, _Material], pos: dict[int, np.ndarray], wt: float
+    ) -> list[RodElement]:
+        sc = self.sc
+        props = self.by_id(("PROD",), "rod property")
+        out: list[RodElement] = []
+        for eid, c in self.by_id(("CROD", "CONROD"), "element").items():
+            if c.name == "CROD":
+                pid = c.integer(2, "PID", eid)
+                if pid not in props:
+                    raise c.error(
+                        f"property {pid} (PROD) is not defined", "add the PROD card or correct PID"
+                    )
+                p = props[pid]
+                mid, a, j, nsm = (
+                    p.integer(2, "MID"),
+                    p.real(3, "A"),
+                    p.real(4, "J", 0.0),
+                    p.real(6, "NSM", 0.0),
+                )
+                g1, g2 = c.raw(3), c.raw(4)
+                mat = self.material(mats, mid, p)
+            else:
+                g1, g2 = c.raw(2), c.raw(3)
+                mat = self.material(mats, c.integer(4, "MID"), c)
+                a, j, nsm = c.real(5, "A"), c.real(6, "J", 0.0), c.real(8, "NSM", 0.0)
+            n1 = self.grid(g1, c, pos, "G1")
+            n2 = self.grid(g2, c, pos, "G2")
+            if not a > 0:
+                raise c.error(f"rod area must be > 0, got {a}")
+            A = a * sc.length**2
+            rho = mat.rho * wt * sc.mass / sc.length**3
+            ename = f"{c.name.lower()}:{eid}"
+            self.origin[ename] = c
+            if float(np.linalg.norm(pos[g2] - pos[g1])) <= 1e-9 * max(
+                float(np.max(np.abs(pos[g1]))), 1e-300
+            ):
+                raise c.error(
+                    "has zero length (its grids coincide)",
+                    "connect distinct grids, or use a CBUSH/CELAS",
+                )
+            out.append(
+                RodElement(
+                    ename,
+                    (n1, n2),
+                    mat.e * A,
+                    mat.g * j * sc.length**4,
+                    rho * A + nsm * wt * sc.mass / sc.length,
+                )
+            )
+        return out
+
+    def bushes(
+        self,
+        pos: dict[int, np.ndarray],
+        axes: dict[int, np.ndarray],
+        frames: dict[int, CoordinateFrame],
+    ) -> list[Spring]:
+        sc = self.sc
+        props: dict[int, tuple[np.ndarray, np.ndarray, float]] = {}
+        for pid, c in self.by_id(("PBUSH",), "bush property").items():
+            k = np.zeros(6)
+            b = np.zeros(6)
+            ge = 0.0
+            i = 2
+            while i < len(c):
+                kw = c.raw(i)
+                vals = [c.real(i + 1 + m, f"{kw}{m + 1}", 0.0) for m in range(6)]
+                if kw == "K":
+                    k = np.array(vals)
+                elif kw == "B":
+                    b = np.array(vals)
+                elif kw == "GE":
+                    ge = vals[0]
+                    if any(v not in (0.0, ge) for v in vals[1:]):
+                        raise c.error("GE per direction is not supported", "give one GE1")
+                elif kw in ("RCV", None):
+                    pass
+                else:
+                    raise c.error(f"PBUSH line {kw!r} is not supported (K, B, GE, RCV are)")
+                i += 8
+            if np.any(k < 0) or np.any(b < 0):
+                raise c.error("negative stiffness or damping")
+            kscale = np.array([sc.force / sc.length] * 3 + [sc.force * sc.length] * 3)
+            props[pid] = (np.diag(k * kscale), np.diag(b * kscale * sc.time), ge)
+        out: list[Spring] = []
+        for eid, c in self.by_id(("CBUSH",), "element").items():
+            pid = c.integer(2, "PID", eid)
+            if pid not in props:
+                raise c.error(
+                    f"property {pid} (PBUSH) is not defined", "add the PBUSH card or correct PID"
+                )
+            k6, b6, ge = props[pid]
+            ga_id = c.raw(3)
+            ga = self.grid(ga_id, c, pos, "GA")
+            gb_id = c.raw(4)
+            gb = None if gb_id in (None, 0) else self.grid(gb_id, c, pos, "GB")
+            pa = pos[ga_id]
+            pb = pa if gb is None else pos[gb_id]
+            ocid = c.integer(10, "OCID", -1)
+            if ocid == -1:
+                s = c.real(9, "S", 0.5)
+                loc = pa + s * (pb - pa)
+            else:
+                fr = self.frame(frames, ocid, c)
+                soff = np.array([c.real(11 + m, f"S{m + 1}", 0.0) for m in range(3)]) * sc.length
+                loc = pa + fr.vector_to_basic(soff, pa)
+            cid = c.raw(8)
+            where = c.where
+            if cid is not None:
+                if not isinstance(cid, int):
+                    raise c.error(f"CID must be an integer, got {cid!r}")
+                ax = self.frame(frames, cid, c).axes_at(loc)
+            else:
+                x1 = c.raw(5)
+                v: np.ndarray | None
+                if x1 is None:
+                    v = None
+                elif isinstance(x1, int):
+                    self.grid(x1, c, pos, "G0")
+                    v = pos[x1] - pa
+                else:
+                    v = np.array([c.real(5 + m, f"X{m + 1}", 0.0) for m in range(3)]) @ axes[ga_id]
+                try:
+                    ax = spring_axes(pa, pb, v, k6, b6, where=where)
+                except InputError as exc:
+                    raise InputError(exc.what, where=where, fix=exc.fix) from None
+            ename = f"cbush:{eid}"
+            self.origin[ename] = c
+            out.append(Spring(ename, (ga, gb), k6, b6, ax, loc, ge))
+        return out
+
+    def scalar_springs(self) -> list[ScalarSpring]:
+        sc = self.sc
+        pelas: dict[int, tuple[float, float, Card]] = {}
+        for c in self.cards:
+            if c.name == "PELAS":
+                for base in (1, 5):
+                    pid = c.raw(base)
+                    if pid is None:
+                        continue
+                    if not isinstance(pid, int) or pid in pelas:
+                        raise c.error(f"PELAS id {pid!r} is invalid or duplicate")
+                    pelas[pid] = (c.real(base + 1, "K"), c.real(base + 2, "GE", 0.0), c)
+        out: list[ScalarSpring] = []
+        grids = getattr(self, "grid_cards", {})
+        for eid, c in self.by_id(("CELAS1", "CELAS2"), "element").items():
+            if c.name == "CELAS1":
+                pid = c.integer(2, "PID", eid)
+                if pid not in pelas:
+                    raise c.error(
+                        f"property {pid} (PELAS) is not defined",
+                        "add the PELAS card or correct PID",
+                    )
+                k, ge, _ = pelas[pid]
+            else:
+                k, ge = c.real(2, "K"), c.real(7, "GE", 0.0)
+            dofs: list[tuple[str, int] | None] = []
+            kinds = []
+            for gi, ci in ((3, 4), (5, 6)):
+                g = c.raw(gi)
+                comp = c.raw(ci)
+                if g in (None, 0):
+                    dofs.append(None)
+                    continue
+                if g not in grids:
+                    raise c.error(
+                        f"grid {g} is not defined (scalar points, SPOINT, are not supported)"
+                    )
+                if not isinstance(comp, int) or comp not in range(1, 7):
+                    raise c.error(
+                        f"component {comp!r} must be 1-6 (scalar points are not supported)"
+                    )
+                dofs.append((f"grid:{g}", comp))
+                kinds.append(comp > 3)
+            if not kinds:
+                raise c.error("connects no grid")
+            n_rot = sum(kinds)
+            if n_rot == 0:
+                scale = sc.force / sc.length
+            elif n_rot == len(kinds):
+                scale = sc.force * sc.length
+            else:
+                scale = sc.force
+            ename = f"{c.name.lower()}:{eid}"
+            self.origin[ename] = c
+            out.append(ScalarSpring(ename, (dofs[0], dofs[1]), k * scale, 0.0, ge))
+        return out
+
+    def conm2(
+        self, pos: dict[int, np.ndarray], frames: dict[int, CoordinateFrame], wt: float
+    ) -> list[ConcentratedMass]:
+        sc = self.sc
+        out: list[ConcentratedMass] = []
+        for eid, c in self.by_id(("CONM2",), "element").items():
+            gid = c.raw(2)
+            node = self.grid(gid, c, pos, "G")
+            cid = c.integer(3, "CID", 0)
+            m = c.real(4, "M", 0.0) * wt * sc.mass
+            x = np.array([c.real(5 + k, f"X{k + 1}", 0.0) for k in range(3)]) * sc.length
+            i11, i21, i22, i31, i32, i33 = (
+                c.real(k, lab, 0.0)
+                for k, lab in zip(
+                    range(9, 15), ("I11", "I21", "I22", "I31", "I32", "I33"), strict=True
+                )
+            )
+            # QRG CONM2 remark: the inertia matrix is
+            # [[I11, -I21, -I31], [-I21, I22, -I32], [-I31, -I32, I33]]
+            j = (
+                np.array([[i11, -i21, -i31], [-i21, i22, -i32], [-i31, -i32, i33]])
+                * wt
+                * sc.mass
+                * sc.length**2
+            )
+            if cid == -1:
+                off = x - pos[gid]
+            else:
+                fr = self.frame(frames, cid, c)
+                ax = fr.axes_at(pos[gid])
+                off = x @ ax
+                j = ax.T @ j @ ax
+            if m < 0:
+                raise c.error(f"mass must be >= 0, got {m}")
+            ename = f"conm2:{eid}"
+            self.origin[ename] = c
+            out.append(ConcentratedMass(ename, node, m, off, j))
+        return out
+
+    def rigid(self, pos: dict[int, np.ndarray]) -> tuple[list[RigidLink], list[Interpolation]]:
+        links: list[RigidLink] = []
+        interps: list[Interpolation] = []
+        for eid, c in self.by_id(("RBE2",), "element").items():
+            gn = self.grid(c.raw(2), c, pos, "GN")
+            cm = self.components(c.raw(3), c, "CM")
+            deps = []
+            for k in range(4, len(c)):
+                v = c.raw(k)
+                if v is None:
+                    continue
+                if isinstance(v, float) and k == len(c) - 1:
+                    break  # ALPHA (thermal expansion)
+                if not isinstance(v, int):
+                    raise c.error(f"field {k + 1}: expected a grid id, got {v!r}")
+                deps.append(self.grid(v, c, pos, "GM"))
+            if not deps:
+                raise c.error("has no dependent grid")
+            ename = f"rbe2:{eid}"
+            self.origin[ename] = c
+            links.append(RigidLink(ename, gn, tuple(deps), cm))
+        for eid, c in self.by_id(("RBE3",), "element").items():
+            ref = self.grid(c.raw(3), c, pos, "REFGRID")
+            refc = self.components(c.raw(4), c, "REFC")
+            srcs: list[tuple[str, str, float]] = []
+            k = 5
+            while k < len(c):
+                v = c.raw(k)
+                if v is None:
+                    k += 1
+                    continue
+                if isinstance(v, str):
+                    if v == "ALPHA":
+                        break
+                    raise c.error(f"{v} (moved dependent DOFs) is not supported", "remove UM")
+                w = float(v)
+                comps = self.components(c.raw(k + 1), c, "C")
+                if any(ch in "456" for ch in comps):
+                    raise c.error(
+                        "rotational independent components (4-6) are not supported",
+                        "give the independent grids' translations 123 only",
+                    )
+                k += 2
+                gids = []
+                while k < len(c) and isinstance(c.raw(k), int | type(None)):
+                    if c.raw(k) is not None:
+                        gids.append(c.raw(k))
+                    k += 1
+                if not gids:
+                    raise c.error("a weight has no grid")
+                srcs += [(self.grid(g, c, pos, "G"), comps, w) for g in gids]
+            ename = f"rbe3:{eid}"
+            self.origin[ename] = c
+            interps.append(Interpolation(ename, ref, refc, tuple(srcs)))
+        return links, interps
+
+    def constraints(self, pos: dict[int, np.ndarray]) -> list[Constraint]:
+        sets: dict[int, list[tuple[str, str]]] = {}
+        adds: dict[int, list[int]] = {}
+        for c in self.cards:
+            if c.name == "SPC":
+                sid = c.integer(1, "SID")
+                for base in (2, 5):
+                    g = c.raw(base)
+                    if g is None:
+                        continue
+                    node = self.grid(g, c, pos, "G")
+                    comps = self.components(c.raw(base + 1), c, "C")
+                    if c.real(base + 2, "D", 0.0):
+                        self.warnings.append(f"{c.where}: enforced displacement ignored")
+                    sets.setdefault(sid, []).append((node, comps))
+            elif c.name == "SPC1":
+                sid = c.integer(1, "SID")
+                comps = self.components(c.raw(2), c, "C")
+                ids = list(c.fields[3:])
+                if len(ids) == 3 and ids[1] == "THRU":
+                    lo, hi = ids[0], ids[2]
+                    ids = [
+                        g
+                        for g in pos
+                        if isinstance(lo, int) and isinstance(hi, int) and lo <= g <= hi
+                    ]
+                for g in ids:
+                    if g is not None:
+                        sets.setdefault(sid, []).append((self.grid(g, c, pos, "G"), comps))
+            elif c.name == "SPCADD":
+                adds[c.integer(1, "SID")] = [v for v in c.fields[2:] if isinstance(v, int)]
+        self.spc_sets = sorted(set(sets) | set(adds))
+        chosen = self.user_spc
+        if chosen is None:
+            picks = sorted(
+                {int(m.group(1)) for ln in self.case if (m := re.match(r"SPC\s*=\s*(\d+)", ln))}
+            )
+            if len(picks) > 1:
+                self.warnings.append(
+                    f"case control selects SPC sets {picks}; constraints from {picks[0]}"
+                )
+            chosen = picks[0] if picks else (self.spc_sets[0] if len(self.spc_sets) == 1 else None)
+        if chosen is None:
+            if self.spc_sets:
+                self.warnings.append(
+                    f"SPC sets {self.spc_sets} present, none selected: no constraints noted"
+                )
+            return []
+        if chosen not in sets and chosen not in adds:
+            raise InputError(
+                f"SPC set {chosen} is not defined", where=self.path, fix=f"defined: {self.spc_sets}"
+            )
+        members = adds.get(chosen, [chosen])
+        out: list[Constraint] = []
+        for sid in members:
+            out += [Constraint(n, comp) for n, comp in sets.get(sid, [])]
+        return out
+
+
+def load_bdf(
+    path: str | Path,
+    units: str | None = None,
+    *,
+    wtmass: float | None = None,
+    spc: int | None = None,
+) -> GraphModel:
+    """Read a NASTRAN bulk data deck into a graph model, SI.
+
+    Parameters
+    ----------
+    path : str or Path
+        The deck; INCLUDE files are read relative to it.
+    units : str
+        ``"LENGTH, FORCE, TIME"`` of the deck, e.g. ``"in, lbf, s"`` (required: NASTRAN files
+        declare none).
+    wtmass : float, optional
+        Factor from the deck's mass input to FORCE TIME^2/LENGTH (NASTRAN ``PARAM,WTMASS``);
+        default the deck's, else 1.  Contradicting the deck's is an error.
+    spc : int, optional
+        SPC set noted as the model's constraints; default the case control's ``SPC = n``.
+
+    Returns
+    -------
+    GraphModel
+        Mass formulation lumped unless ``PARAM,COUPMASS`` > 0; ``constraints`` the SPC set
+        (not applied unless :func:`~microg.structure.frame.build_frame` is asked to);
+        ``meta`` the units, WTMASS, ignored cards and parameters, and ``warnings``.
+    """
+    length, force, time = unit_scales(units, where="units")
+    cards, case = read_cards(path)
+    deck = _Deck(cards, case, str(path), _Scales(length, force, time), wtmass, spc)
+    return deck.build()

@@ -1,0 +1,591 @@
+"""Tests of microg.structure.frame: element kernels, link elimination, assembly, condensation.
+
+References: textbook closed forms (Timoshenko cantilever under end load, pinned-fixed beam,
+spring-mass systems), numerical integration of the Friedman-Kosmatka shape functions,
+hand calculations of rigid-body mass properties and RBE3 averages, and scipy's generalized
+eigensolver on the uncondensed pencil.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import scipy.linalg as sla
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from microg.dynamics.modes import solve_modes
+from microg.errors import InputError
+from microg.models.graph import (
+    BeamElement,
+    BeamSection,
+    ConcentratedMass,
+    Constraint,
+    GraphModel,
+    GraphPoint,
+    Interpolation,
+    Node,
+    RigidLink,
+    RodElement,
+    ScalarSpring,
+    Spring,
+)
+from microg.models.toml import load_station
+from microg.structure.fem import build_fem, frame_mass_local, frame_stiffness_local, rigid_link
+from microg.structure.frame import (
+    FrameSamples,
+    assemble_frame,
+    beam_mass_consistent_local,
+    beam_mass_lumped_local,
+    beam_stiffness_local,
+    build_frame,
+    bush_matrix,
+    graph_from_station,
+    interpolation_matrix,
+    release_ends,
+    rod_mass_local,
+    shear_parameter,
+)
+
+RNG = np.random.default_rng(7)
+
+
+def _node(name, x, y=0.0, z=0.0):
+    return Node(name, np.array([x, y, z], float))
+
+
+def _section(**kw):
+    base = dict(
+        name="s",
+        ea_N=2e8,
+        ei_y_N_m2=3e5,
+        ei_z_N_m2=5e5,
+        gj_N_m2=2e5,
+        mass_per_length_kg_per_m=4.0,
+        polar_mass_kg_m=0.02,
+    )
+    base.update(kw)
+    return BeamSection(**base)
+
+
+def _chain(n, length=3.0, section=None, mass="consistent", **kw):
+    sec = section or _section()
+    nodes = tuple(_node(f"n{i}", length * i / n) for i in range(n + 1))
+    beams = tuple(
+        BeamElement(f"e{i}", (f"n{i}", f"n{i + 1}"), sec, np.array([0.0, 1.0, 0.0]))
+        for i in range(n)
+    )
+    return GraphModel("chain", nodes, beams=beams, mass_formulation=mass, **kw)
+
+
+# --------------------------------------------------------------------------- kernels
+
+
+def test_timoshenko_stiffness_reduces_to_euler_bernoulli():
+    L = np.array([0.7, 2.0])
+    args = (L, [1e8, 2e8], [3e5, 1e5], [4e5, 2e5], [1e5, 3e5])
+    # phi = 0 is the fem kernel exactly (one definition of the Euler-Bernoulli element)
+    np.testing.assert_array_equal(beam_stiffness_local(*args), frame_stiffness_local(*args))
+
+
+def test_timoshenko_cantilever_end_load_is_exact():
+    # One element, clamped at a: tip deflection P L^3/(3 EI) + P L/(k G A) and tip rotation
+    # P L^2/(2 EI) are the exact Timoshenko static solution (Przemieniecki sec. 5.6), which
+    # the shear-deformable element reproduces for any phi; 1e-12 is rounding.
+    L, ei, ks = 1.3, 2e5, 7e5
+    phi = shear_parameter(np.array([L]), np.array([ei]), np.array([ks]))
+    k = beam_stiffness_local(np.array([L]), [1e8], [ei], [ei], [1e5], phi, phi)[0]
+    kb = k[6:, 6:]
+    for plane, (iv, it, sgn) in {"v": (1, 5, 1.0), "w": (2, 4, -1.0)}.items():
+        load = np.zeros(6)
+        load[iv] = 1.0
+        u = np.linalg.solve(kb, load)
+        assert u[iv] == pytest.approx(L**3 / (3 * ei) + L / ks, rel=1e-12), plane
+        assert u[it] == pytest.approx(sgn * L**2 / (2 * ei), rel=1e-12), plane
+
+
+def test_consistent_mass_is_fem_kernel_without_shear_and_rotary_inertia():
+    L = np.array([0.5, 1.5])
+    m = np.array([3.0, 7.0])
+    j = np.array([0.1, 0.2])
+    np.testing.assert_allclose(
+        beam_mass_consistent_local(L, m, j), frame_mass_local(L, m, j), rtol=1e-14, atol=1e-15
+    )
+
+
+def test_consistent_mass_integrates_friedman_kosmatka_shape_functions():
+    # M = int (rho A N_v^T N_v + rho I N_t^T N_t) dx with the interdependent shape functions
+    # of Friedman & Kosmatka (1993), integrated by 8-point Gauss-Legendre (exact for these
+    # degree-6 polynomials): agreement to rounding (1e-13).
+    L, phi, m, r = 1.7, 0.37, 2.3, 0.11
+    xg, wg = np.polynomial.legendre.leggauss(8)
+    xi = 0.5 * (xg + 1)
+    w = 0.5 * wg * L
+    f = 1 / (1 + phi)
+    Nv = np.stack(
+        [
+            f * (2 * xi**3 - 3 * xi**2 - phi * xi + 1 + phi),
+            f * L * (xi**3 - (2 + phi / 2) * xi**2 + (1 + phi / 2) * xi),
+            f * (-2 * xi**3 + 3 * xi**2 + phi * xi),
+            f * L * (xi**3 - (1 - phi / 2) * xi**2 - (phi / 2) * xi),
+        ]
+    )
+    Nt = np.stack(
+        [
+            6 * f / L * (xi**2 - xi),
+            f * (3 * xi**2 - (4 + phi) * xi + 1 + phi),
+            -6 * f / L * (xi**2 - xi),
+            f * (3 * xi**2 - (2 - phi) * xi),
+        ]
+    )
+    ref = m * (Nv * w) @ Nv.T + r * (Nt * w) @ Nt.T
+    full = beam_mass_consistent_local(
+        np.array([L]), [m], [0.0], np.array([phi]), np.array([phi]), [r], [r]
+    )[0]
+    idx_v = [1, 5, 7, 11]
+    np.testing.assert_allclose(full[np.ix_(idx_v, idx_v)], ref, rtol=1e-13, atol=1e-15)
+    # x-z plane: theta_y = -dw/dx flips the signs of the rotation rows and columns
+    s = np.diag([1.0, -1.0, 1.0, -1.0])
+    idx_w = [2, 4, 8, 10]
+    np.testing.assert_allclose(full[np.ix_(idx_w, idx_w)], s @ ref @ s, rtol=1e-13, atol=1e-15)
+
+
+def test_lumped_mass_is_nastran_translational_lumping():
+    L = np.array([2.0, 2.0])
+    m = beam_mass_lumped_local(L, [3.0, 3.0], [0.5, 0.5], np.array([True, False]))
+    # half of m' L = 3 kg on every end translation, nothing on bending rotations; the CBEAM
+    # (True) lumps half of rho J L = 0.5 kg m^2 on the axial rotations, the CBAR does not
+    for e in range(2):
+        assert np.count_nonzero(m[e] - np.diag(np.diag(m[e]))) == 0
+        np.testing.assert_array_equal(np.diag(m[e])[[0, 1, 2, 6, 7, 8]], 3.0)
+        np.testing.assert_array_equal(np.diag(m[e])[[4, 5, 10, 11]], 0.0)
+    assert m[0, 3, 3] == m[0, 9, 9] == 0.5
+    assert m[1, 3, 3] == m[1, 9, 9] == 0.0
+
+
+def test_rod_mass_forms_conserve_mass():
+    L = np.array([1.5])
+    for lumped in (True, False):
+        m = rod_mass_local(L, [2.0], lumped)[0]
+        # a unit translation in each direction carries the rod's whole mass, 3 kg
+        for d in range(3):
+            u = np.zeros(12)
+            u[[d, d + 6]] = 1.0
+            assert u @ m @ u == pytest.approx(3.0, rel=1e-15)
+
+
+def test_pin_release_gives_pinned_fixed_beam_stiffness():
+    # Released rotation about z at end b: the lateral stiffness at b with end a clamped is
+    # the propped-cantilever value 3 EI / L^3 (Przemieniecki Table 5.1), exact to rounding.
+    L, ei = 2.0, 4e5
+    k = beam_stiffness_local(np.array([L]), [1e8], [ei], [ei], [1e5])
+    m = frame_mass_local(np.array([L]), [1.0], [0.0])
+    rel = np.zeros((1, 12), bool)
+    rel[0, 11] = True  # theta_z at end b
+    kr, mr = release_ends(k, m, rel)
+    assert np.all(kr[0, 11] == 0) and np.all(mr[0, :, 11] == 0)
+    assert kr[0, 7, 7] == pytest.approx(3 * ei / L**3, rel=1e-12)
+    np.testing.assert_allclose(kr[0], kr[0].T, atol=1e-9)
+
+
+def test_bush_matrix_is_free_of_rigid_body_forces_and_diagonal_at_its_point():
+    k6 = np.diag([1e5, 2e5, 3e5, 10.0, 20.0, 30.0])
+    axes = sla.qr(RNG.standard_normal((3, 3)))[0]
+    axes *= np.sign(np.linalg.det(axes))
+    a, b = np.array([0.0, 0, 0]), np.array([1.0, 0.5, 0.2])
+    loc = np.array([0.3, 0.9, -0.4])
+    K = bush_matrix(k6, axes, a, b, loc)
+    # rigid motion: every node moves as u = t + r x p: the spring force must vanish (1e-9 of
+    # the largest term times the motion: rounding)
+    for col in range(6):
+        ua = np.zeros(6)
+        ua[col] = 1.0
+        ra = rigid_link(a) @ ua
+        rb = rigid_link(b) @ ua
+        assert np.abs(K @ np.concatenate([ra, rb])).max() <= 1e-10 * np.abs(K).max()
+    # coincident nodes at the spring point, basic axes: K = [[k, -k], [-k, k]] exactly
+    Kc = bush_matrix(k6, np.eye(3), a, a, a)
+    np.testing.assert_allclose(Kc, np.block([[k6, -k6], [-k6, k6]]), rtol=1e-15)
+
+
+def test_interpolation_matches_hand_average_and_moves_rigidly():
+    # four sources at (+-1, 0, 0), (0, +-1, 0), equal weights, reference at the origin: by
+    # hand, the translation is the mean, theta_z = sum(x u_y - y u_x) / sum(x^2 + y^2),
+    # theta_x = sum(y u_z) / sum(y^2), theta_y = -sum(x u_z) / sum(x^2); exact to rounding
+    pos = np.array([[1.0, 0, 0], [-1.0, 0, 0], [0, 1.0, 0], [0, -1.0, 0]])
+    u = RNG.standard_normal((4, 3))
+    dirs = np.tile(np.eye(3), (4, 1))
+    W = interpolation_matrix(np.zeros(3), np.repeat(pos, 3, axis=0), dirs, np.ones(12))
+    q = W @ u.ravel()
+    np.testing.assert_allclose(q[:3], u.mean(axis=0), atol=1e-14)
+    x, y = pos[:, 0], pos[:, 1]
+    assert q[5] == pytest.approx(np.sum(x * u[:, 1] - y * u[:, 0]) / np.sum(x**2 + y**2), abs=1e-14)
+    assert q[3] == pytest.approx(np.sum(y * u[:, 2]) / np.sum(y**2), abs=1e-14)
+    assert q[4] == pytest.approx(-np.sum(x * u[:, 2]) / np.sum(x**2), abs=1e-14)
+    # a rigid motion of irregular, unequally weighted sources is returned exactly
+    pos2 = RNG.standard_normal((5, 3))
+    ref = np.array([0.2, -0.1, 0.3])
+    t, r = RNG.standard_normal(3), RNG.standard_normal(3)
+    us = t + np.cross(r, pos2 - ref)
+    W2 = interpolation_matrix(
+        ref, np.repeat(pos2, 3, axis=0), np.tile(np.eye(3), (5, 1)), np.arange(1.0, 16.0)
+    )
+    np.testing.assert_allclose(W2 @ us.ravel(), np.concatenate([t, r]), atol=1e-12)
+    with pytest.raises(InputError, match="do not determine"):
+        interpolation_matrix(ref, np.repeat(pos2[:1], 3, axis=0), np.eye(3), np.ones(3))
+
+
+# --------------------------------------------------------------------------- assembly
+
+
+def _truss_loop(mass="consistent"):
+    """A closed square frame with a diagonal rod, two masses and a CBUSH-mounted payload."""
+    sec = _section()
+    pts = {"a": (0, 0, 0), "b": (2, 0, 0), "c": (2, 2, 0), "d": (0, 2, 0.5), "p": (2, 2, 0)}
+    nodes = tuple(Node(k, np.array(v, float)) for k, v in pts.items())
+    ring = [("a", "b"), ("b", "c"), ("c", "d"), ("d", "a")]
+    beams = tuple(
+        BeamElement(
+            f"e{i}", pair, sec, np.array([0.0, 0.0, 1.0]) if i % 2 == 0 else np.array([1.0, 0, 0.3])
+        )
+        for i, pair in enumerate(ring)
+    )
+    rods = (RodElement("diag", ("a", "c"), 1e7, 0.0, 1.0),)
+    k6 = np.diag([1e4, 2e4, 3e4, 50.0, 60.0, 70.0])
+    springs = (Spring("iso", ("c", "p"), k6, 0.01 * k6, np.eye(3), np.array(pts["c"], float)),)
+    j = np.array([[2.0, 0.1, 0], [0.1, 3.0, 0], [0, 0, 4.0]])
+    masses = (
+        ConcentratedMass("m1", "b", 5.0, np.array([0.1, 0.0, 0.2]), 0.5 * j),
+        ConcentratedMass("pay", "p", 20.0, np.zeros(3), j),
+    )
+    points = (GraphPoint("crew", "d", np.array([0.0, 2.3, 0.5])),)
+    return GraphModel(
+        "loop",
+        nodes,
+        beams=beams,
+        rods=rods,
+        springs=springs,
+        masses=masses,
+        points=points,
+        mass_formulation=mass,
+    )
+
+
+@pytest.fixture(params=["consistent", "lumped"])
+def loop(request):
+    return _truss_loop(request.param), build_frame(_truss_loop(request.param))
+
+
+def test_loop_matrices_symmetric_rigid_vectors_annihilated(loop):
+    _, s = loop
+    M, K = s.dense()
+    np.testing.assert_allclose(M, M.T, atol=1e-12 * np.abs(M).max())
+    assert np.linalg.eigvalsh(M).min() > 0  # massless DOFs condensed out
+    R = np.column_stack(list(s.rigid_body.values()))
+    # exact rigid vectors: K R vanishes to rounding, row by row (RIGID_TOL = 1e-12)
+    assert np.max(np.abs(K @ R) / np.maximum(np.abs(K) @ np.abs(R), 1e-300)) < 1e-12
+
+
+def test_loop_has_six_exact_rigid_modes_and_hand_mass_properties(loop):
+    graph, s = loop
+    m = solve_modes(s)
+    assert m.n_rigid == 6
+    assert np.all(m.omega[m.rigid] == 0.0) and np.all(m.omega[~m.rigid] > 0)
+    # hand sums: beams m' L (4 kg/m, lengths 2, 2, sqrt(4.25), sqrt(4.25)), rod 1 kg/m over
+    # 2 sqrt(2) m, masses 5 + 20 kg; the same for both mass formulations to rounding
+    lengths = [2.0, 2.0, np.sqrt(4.25), np.sqrt(4.25)]
+    total = 4.0 * sum(lengths) + 2 * np.sqrt(2) + 25.0
+    assert s.total_mass == pytest.approx(total, rel=1e-13)
+    # first moment: each beam's mass at its midpoint (consistent and lumped both put the
+    # element's centroid there), rod likewise, masses at their centres
+    pos = {n.name: n.position for n in graph.nodes}
+    first = sum(
+        4.0 * L * 0.5 * (pos[b.nodes[0]] + pos[b.nodes[1]])
+        for L, b in zip(lengths, graph.beams, strict=True)
+    )
+    first = first + 2 * np.sqrt(2) * 0.5 * (pos["a"] + pos["c"])
+    first = first + 5.0 * (pos["b"] + [0.1, 0, 0.2]) + 20.0 * pos["p"]
+    np.testing.assert_allclose(s.center_of_mass, first / total, rtol=1e-12, atol=1e-14)
+
+
+def test_condensed_lumped_model_has_the_finite_eigenvalues_of_the_full_pencil():
+    graph = _truss_loop("lumped")
+    s = build_frame(graph)
+    assert s.meta["condensed"] > 0 and not s.is_sparse
+    # independent reference: scipy's QZ on the uncondensed (singular-M) pencil, links
+    # eliminated by the same transform; its finite, non-rigid eigenvalues must be ours
+    fm = assemble_frame(graph)
+    T = fm.transform.toarray()
+    K = T.T @ fm.stiffness.toarray() @ T
+    M = T.T @ fm.mass.toarray() @ T
+    live = (np.abs(K).sum(1) > 0) | (np.abs(M).sum(1) > 0)
+    lam = sla.eig(K[np.ix_(live, live)], M[np.ix_(live, live)], right=False)
+    lam = np.sort(np.real(lam[np.isfinite(lam)]))
+    scale = lam.max()
+    elastic = lam[lam > 1e-8 * scale]
+    m = solve_modes(s)
+    w2 = np.sort(m.omega[~m.rigid] ** 2)
+    # QZ accuracy ~1e-12 of the largest eigenvalue; relative 1e-8 on the elastic ones
+    np.testing.assert_allclose(w2, elastic, rtol=1e-8)
+
+
+def test_point_maps_and_samples_follow_condensed_recovery():
+    graph = _truss_loop("lumped")
+    s = build_frame(graph)
+    samples = s.samples
+    assert isinstance(samples, FrameSamples)
+    q = RNG.standard_normal(s.n_dof)
+    # the recovered independent set satisfies the massless equations K_oa q + K_oo u_o = 0
+    fm = assemble_frame(graph)
+    T = s.meta["transform"]
+    Kn = (T.T @ fm.stiffness @ T).toarray()
+    u = samples.expand(q)
+    o = samples.condensed
+    assert np.abs(Kn[o] @ u).max() <= 1e-9 * np.abs(Kn[o]).max() * np.abs(u).max()
+    # named point and node maps agree with the samples (the same recovery, 1e-12)
+    lab = list(samples.labels)
+    d = samples.displacement(q)
+    for name in ("d", "b", "p"):
+        np.testing.assert_allclose(
+            s.points[name].translation @ q, d[lab.index(name)], rtol=1e-12, atol=1e-14
+        )
+    crew = s.point("crew")
+    th = s.points["d"].rotation @ q
+    expect = s.points["d"].translation @ q + np.cross(th, [0.0, 0.3, 0.0])
+    np.testing.assert_allclose(crew.translation @ q, expect, rtol=1e-12, atol=1e-14)
+    assert "d" in s.points and list(s.points) == ["crew"]
+
+
+def test_rbe2_rigid_body_has_hand_mass_properties():
+    # masses on four grids tied by an RBE2 to a master grid: a single rigid body; its
+    # 6x6 mass matrix about the master equals the hand sum of m [I, -[d]x; [d]x, J + ...]
+    pos = RNG.standard_normal((4, 3))
+    ms = np.array([1.0, 2.0, 3.0, 4.0])
+    nodes = (Node("master", np.zeros(3)),) + tuple(Node(f"s{i}", pos[i]) for i in range(4))
+    j0 = np.diag([0.1, 0.2, 0.3])
+    masses = tuple(ConcentratedMass(f"m{i}", f"s{i}", ms[i], np.zeros(3), j0) for i in range(4))
+    link = (RigidLink("rbe2", "master", tuple(f"s{i}" for i in range(4))),)
+    s = build_frame(GraphModel("body", nodes, masses=masses, rigid_links=link))
+    assert s.n_dof == 6
+    total = ms.sum()
+    cm = ms @ pos / total
+    rel = pos - cm
+    inertia = 4 * j0 + sum(
+        m * (r @ r * np.eye(3) - np.outer(r, r)) for m, r in zip(ms, rel, strict=True)
+    )
+    assert s.total_mass == pytest.approx(total, rel=1e-14)
+    np.testing.assert_allclose(s.center_of_mass, cm, atol=1e-14)
+    np.testing.assert_allclose(s.inertia_cm, inertia, atol=1e-13)
+    m = solve_modes(s)
+    assert m.n_rigid == 6 and m.n_modes == 6
+
+
+def test_rbe3_reference_follows_hand_average_through_assembly():
+    pos = {
+        "r": (0, 0, 0.0),
+        "a": (1, 0, 0.0),
+        "b": (-1, 0, 0.0),
+        "c": (0, 1, 0.0),
+        "d": (0, -1, 0.0),
+    }
+    nodes = tuple(Node(k, np.array(v, float)) for k, v in pos.items())
+    sources = tuple((k, "123", 1.0) for k in "abcd")
+    ip = Interpolation("rbe3", "r", "123456", sources)
+    # grounded springs on the sources so the graph is connected; masses so it has mass
+    springs = tuple(
+        Spring(
+            f"k{k}",
+            (k, None),
+            np.eye(6) * 1e3,
+            np.zeros((6, 6)),
+            np.eye(3),
+            np.array(pos[k], float),
+        )
+        for k in "abcd"
+    )
+    masses = tuple(ConcentratedMass(f"m{k}", k, 1.0) for k in "abcd")
+    g = GraphModel("rbe3", nodes, springs=springs, masses=masses, interpolations=(ip,))
+    fm = assemble_frame(g)
+    u = RNG.standard_normal(len(fm.independent))
+    ug = (fm.transform @ u).reshape(-1, 6)
+    src = ug[1:, :3]
+    x = np.array([1.0, -1, 0, 0])
+    y = np.array([0.0, 0, 1, -1])
+    np.testing.assert_allclose(ug[0, :3], src.mean(axis=0), atol=1e-14)
+    assert ug[0, 5] == pytest.approx(np.sum(x * src[:, 1] - y * src[:, 0]) / 4.0, abs=1e-14)
+    assert ug[0, 3] == pytest.approx(np.sum(y * src[:, 2]) / 2.0, abs=1e-14)
+
+
+def test_link_errors_are_reported():
+    nodes = (_node("a", 0), _node("b", 1), _node("c", 2))
+    m = (ConcentratedMass("m", "a", 1.0),)
+    twice = (RigidLink("r1", "a", ("b",)), RigidLink("r2", "c", ("b",)))
+    with pytest.raises(InputError, match="dependent in both r1 and r2"):
+        assemble_frame(GraphModel("x", nodes, masses=m, rigid_links=twice))
+    cycle = (
+        RigidLink("r1", "a", ("b",)),
+        RigidLink("r2", "b", ("c",)),
+        RigidLink("r3", "c", ("a",)),
+    )
+    with pytest.raises(InputError, match="cycle"):
+        assemble_frame(GraphModel("x", nodes, masses=m, rigid_links=cycle))
+    # a chain a -> b -> c resolves: c follows a rigidly
+    chain = (RigidLink("r1", "a", ("b",)), RigidLink("r2", "b", ("c",)))
+    fm = assemble_frame(GraphModel("x", nodes, masses=m, rigid_links=chain))
+    u = RNG.standard_normal(6)
+    ug = (fm.transform @ u).reshape(3, 6)
+    np.testing.assert_allclose(ug[2, :3], u[:3] + np.cross(u[3:], [2.0, 0, 0]), atol=1e-14)
+
+
+def test_massless_mechanism_and_zero_length_are_input_errors():
+    sec = _section(mass_per_length_kg_per_m=0.0, polar_mass_kg_m=0.0)
+    nodes = (_node("a", 0), _node("b", 1), _node("c", 2))
+    # c's components 1 and 2 are tied to each other only: both have stiffness, neither mass,
+    # and moving together they store no energy: a massless mechanism
+    beams = (BeamElement("e", ("a", "b"), sec, np.array([0.0, 1, 0])),)
+    cel2 = (ScalarSpring("k2", (("c", 1), ("c", 2)), 1e3),)
+    masses = (ConcentratedMass("m", "a", 1.0, np.zeros(3), np.eye(3)),)
+    g = GraphModel(
+        "x", nodes, beams=beams, scalar_springs=cel2, masses=masses, mass_formulation="lumped"
+    )
+    with pytest.raises(InputError, match="mechanism"):
+        build_frame(g)
+    zero = (
+        BeamElement(
+            "z", ("a", "b"), sec, np.array([0.0, 1, 0]), np.array([[0.0, 0, 0], [-1.0, 0, 0]])
+        ),
+    )
+    with pytest.raises(InputError, match="zero length"):
+        build_frame(GraphModel("x", nodes, beams=zero, masses=masses))
+
+
+def test_offsets_equal_rigid_links():
+    # a beam with rigid end offsets = the same beam between offset points tied by RBE2s
+    sec = _section()
+    off = np.array([[0.0, 0.2, 0.1], [0.1, -0.3, 0.0]])
+    nodes = (_node("a", 0), _node("b", 2))
+    m = (
+        ConcentratedMass("ma", "a", 3.0, np.zeros(3), np.eye(3)),
+        ConcentratedMass("mb", "b", 2.0, np.zeros(3), np.eye(3)),
+    )
+    g1 = GraphModel(
+        "o", nodes, beams=(BeamElement("e", ("a", "b"), sec, np.array([0.0, 0, 1]), off),), masses=m
+    )
+    nodes2 = nodes + (
+        Node("a2", nodes[0].position + off[0]),
+        Node("b2", nodes[1].position + off[1]),
+    )
+    links = (RigidLink("ra", "a", ("a2",)), RigidLink("rb", "b", ("b2",)))
+    g2 = GraphModel(
+        "o",
+        nodes2,
+        beams=(BeamElement("e", ("a2", "b2"), sec, np.array([0.0, 0, 1])),),
+        masses=m,
+        rigid_links=links,
+    )
+    s1, s2 = build_frame(g1), build_frame(g2)
+    np.testing.assert_allclose(s1.dense()[1], s2.dense()[1], rtol=1e-12, atol=1e-6)
+    np.testing.assert_allclose(s1.dense()[0], s2.dense()[0], rtol=1e-12, atol=1e-12)
+
+
+def test_principal_axes_of_a_skewed_section():
+    # a section whose element axes are turned by alpha from its principal axes has
+    # EI_y', EI_z', EI_yz' from the tensor rotation; bending about the principal axes must give
+    # the same frequencies as the unrotated section (tensor invariance, 1e-10)
+    a, b, alpha = 4e5, 1e5, 0.4
+    c, s_ = np.cos(alpha), np.sin(alpha)
+    B = np.array([[a, 0], [0, b]])
+    Rm = np.array([[c, -s_], [s_, c]])
+    Bp = Rm.T @ B @ Rm
+    sec0 = _section(ei_z_N_m2=a, ei_y_N_m2=b)
+    sec1 = _section(ei_z_N_m2=Bp[0, 0], ei_y_N_m2=Bp[1, 1], ei_yz_N_m2=Bp[0, 1])
+    f = []
+    for sec in (sec0, sec1):
+        g = _chain(6, section=sec, constraints=(Constraint("n0", "123456"),))
+        f.append(solve_modes(build_frame(g, constrained=True)).omega)
+    np.testing.assert_allclose(f[1], f[0], rtol=1e-10)
+
+
+def test_scalar_spring_in_rotated_axes():
+    # CELAS along a node's rotated axis 1 = basic direction e: stiffness k e e^T on its
+    # translations (and the spring is between the node and ground)
+    e = np.array([0.6, 0.8, 0.0])
+    axes = np.array([e, [-0.8, 0.6, 0.0], [0, 0, 1.0]])
+    nodes = (Node("a", np.zeros(3), axes, "cs:1"),)
+    g = GraphModel(
+        "k",
+        nodes,
+        scalar_springs=(ScalarSpring("k", (("a", 1), None), 5e3),),
+        masses=(ConcentratedMass("m", "a", 2.0),),
+    )
+    fm = assemble_frame(g)
+    np.testing.assert_allclose(fm.stiffness.toarray()[:3, :3], 5e3 * np.outer(e, e), rtol=1e-14)
+
+
+def test_station_as_graph_matches_build_fem():
+    # graph_from_station meshes the tree as build_fem does: the same matrices node for node
+    # (1e-13 of the largest entry: summation order) and the same frequencies to 1e-9 (the
+    # dense solver's rounding on the IOC's spread of 1e6 in stiffness)
+    station = load_station("ioc")
+    for gg in (False, True):
+        s_fem = build_fem(station, elements_per_beam=8, gravity_gradient=gg)
+        s_fr = build_frame(graph_from_station(station, elements_per_beam=8, gravity_gradient=gg))
+        assert s_fr.dof_labels == s_fem.dof_labels
+        kf, kg = s_fem.stiffness.toarray(), s_fr.stiffness.toarray()
+        mf, mg = s_fem.mass.toarray(), s_fr.mass.toarray()
+        assert np.abs(kf - kg).max() <= 1e-13 * np.abs(kf).max()
+        assert np.abs(mf - mg).max() <= 1e-13 * np.abs(mf).max()
+        w_fem = solve_modes(s_fem, 30).omega
+        w_fr = solve_modes(s_fr, 30).omega
+        el = w_fem > 1e-2  # elastic; below: exact rigid zeros and the two librations
+        np.testing.assert_array_equal(w_fr == 0, w_fem == 0)
+        np.testing.assert_allclose(w_fr[el], w_fem[el], rtol=1e-9)
+        # the librations' stiffness is ~1e-7 of the elastic one: a rounding-level difference
+        # of the two assemblies (1e-16 of |K| |r| per row) moves them by ~1e-4 (see
+        # test_fem.test_gravity_gradient_librations_eq_2_30), so they agree to 1e-3
+        lib = (w_fem > 0) & ~el
+        assert np.count_nonzero(lib) == (2 if gg else 0)
+        np.testing.assert_allclose(w_fr[lib], w_fem[lib], rtol=1e-3)
+        assert s_fr.total_mass == pytest.approx(s_fem.total_mass, rel=1e-14)
+        # the consistent mass moves rigid motion exactly, so its inertia is the station's
+        # continuous one (1e-12 of the largest moment: rounding)
+        np.testing.assert_allclose(
+            s_fr.inertia_cm, s_fem.inertia_cm, atol=1e-12 * np.abs(s_fem.inertia_cm).max()
+        )
+        for p in station.points:
+            np.testing.assert_allclose(
+                s_fr.point(p.name).translation, s_fem.point(p.name).translation, atol=1e-12
+            )
+
+
+@settings(max_examples=15)
+@given(st.floats(-np.pi, np.pi), st.floats(-1.0, 1.0), st.floats(-np.pi, np.pi))
+def test_frequencies_invariant_under_rotation_of_the_model(yaw, tilt, roll):
+    # rotating every position, orientation, spring axes and inertia rigidly must leave the
+    # frequencies unchanged (frame objectivity); 1e-9 relative is the dense solver's rounding
+    def rot(a, b, c):
+        ca, sa, cb, sb, cc, sc = np.cos(a), np.sin(a), np.cos(b), np.sin(b), np.cos(c), np.sin(c)
+        rz = np.array([[ca, -sa, 0], [sa, ca, 0], [0, 0, 1]])
+        ry = np.array([[cb, 0, sb], [0, 1, 0], [-sb, 0, cb]])
+        rx = np.array([[1, 0, 0], [0, cc, -sc], [0, sc, cc]])
+        return rz @ ry @ rx
+
+    Q = rot(yaw, tilt, roll)
+    g = _truss_loop("consistent")
+    nodes = tuple(Node(n.name, Q @ n.position) for n in g.nodes)
+    beams = tuple(
+        BeamElement(b.name, b.nodes, b.section, Q @ b.orientation, b.offsets @ Q.T) for b in g.beams
+    )
+    springs = tuple(
+        Spring(s.name, s.nodes, s.stiffness, s.damping, s.axes @ Q.T, Q @ s.location)
+        for s in g.springs
+    )
+    masses = tuple(
+        ConcentratedMass(m.name, m.node, m.mass_kg, Q @ m.offset_m, Q @ m.inertia_kg_m2 @ Q.T)
+        for m in g.masses
+    )
+    g2 = GraphModel("rot", nodes, beams=beams, rods=g.rods, springs=springs, masses=masses)
+    w1 = solve_modes(build_frame(g)).omega
+    w2 = solve_modes(build_frame(g2)).omega
+    np.testing.assert_allclose(w2[6:], w1[6:], rtol=1e-9)
+    assert np.all(w2[:6] == 0.0)
