@@ -1,45 +1,154 @@
-"""Benchmark: exact modal response (microg.dynamics.response) against scipy.signal.lsim, same run.
+"""Benchmark: exact modal response (microg.dynamics.response) against strong baselines, same run.
 
-Problem (the issue's "Speed" item): 100 modes (6 rigid, omega = 0; 94 elastic, 0.1-40 Hz, zeta 0
-to 0.02), 20,001 uniform output times over 0-200 s, the report's crew push-off (Eq. 2.16: f0 = 25
-lbf = 111.2 N, t1 = 1 s, t13 = 13 s, t14 = 14 s), random mode shapes and three observed points.
+Problem (issue 10 section 6): 100 modes (6 rigid, omega = 0; 94 elastic, 0.1-40 Hz, zeta 0 to
+0.02), 20,001 output times over 0-200 s, the report's crew push-off (Eq. 2.16: f0 = 25 lbf =
+111.2 N, t1 = 1 s, t13 = 13 s, t14 = 14 s), random mode shapes and three observed points.
 
-Baseline: scipy.signal.lsim on ONE block-diagonal state-space system of all modes (200 states,
-outputs eta, eta', eta'').  This is the fastest fair lsim baseline: lsim per mode (100 calls) was
-measured ~30 times slower, because each call repeats lsim's Python loop over the 20,001 steps.
+Baselines, timed in the same process:
 
-lsim interpolates the input linearly between samples, so it cannot represent the push-off's
-jumps at t1 and t13: it sees a ramp over the one step before each jump.  For the agreement check
-both solvers get exactly that force (breakpoints 0, 0.99, 1, 12.99, 13, 14 s); the size of lsim's
-error on the true force (with jumps) is printed separately.
+* a compiled per-mode recurrence (numba, the ``bench`` extra): for each mode, step from output
+  time to output time with the exact step functions g, h, S, R of the elapsed time (computed once
+  per distinct step length), splitting a step at every force breakpoint inside it.  This is the
+  fastest way to get the same exact values on any grid; single-threaded, like microg's 1-thread
+  figures.  The aim (issue 10) is microg within 1.5x of it.
+* scipy.signal.lsim on ONE block-diagonal state-space system of all modes (200 states), the
+  best lsim can do (per-mode calls are ~30 times slower).  lsim interpolates the input linearly
+  between samples, so for the agreement check both solvers get the push-off as lsim sees it.
+* pyyeti's SolveUnc (when installed).
 
-Run:  .venv/bin/python benchmarks/bench_response.py   (about 10 s)
+Grids: the uniform 0.01 s grid; a piecewise-uniform grid (0.01 s to 50 s, 0.02 s to 200 s, with
+the force breakpoints inserted); and the uniform grid with the landing jump off the grid
+(t13 = 13.000000001 s), for the exact peak (issue 9).  BLAS is limited to 1 thread for the
+comparisons (2-thread figures printed beside them: on 2 cores they are often slower).
+
+Run:  .venv/bin/python benchmarks/bench_response.py   (about 30 s)
 """
 
 from __future__ import annotations
 
 import importlib.util
 import time
+from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 from scipy import signal
 from scipy.linalg import block_diag
+from threadpoolctl import threadpool_limits
 
 from microg.dynamics.forces import crew_pushoff, piecewise_linear
-from microg.dynamics.response import modal_pwl_response, response_at_points
+from microg.dynamics.response import modal_pwl_response, peak_response, response_at_points
 
 N_MODES, N_RIGID, N_DOF = 100, 6, 300
 T_END, N_T = 200.0, 20_001
-REPEAT = 5
+REPEAT = 7
 
 
-def best_of(fn, repeat=REPEAT):
+def best_of(fn: Callable[[], Any], repeat: int = REPEAT) -> tuple[float, Any]:
     times, out = [], None
     for _ in range(repeat):
         t0 = time.perf_counter()
         out = fn()
         times.append(time.perf_counter() - t0)
     return min(times), out
+
+
+def numba_recurrence() -> Callable[..., np.ndarray] | None:
+    """The compiled per-mode exact recurrence (None when numba is not installed)."""
+    if importlib.util.find_spec("numba") is None:
+        return None
+    import numba  # type: ignore[import-not-found]
+
+    @numba.njit(cache=False)
+    def funcs(w: float, z: float, tau: float) -> tuple[float, float, float, float]:
+        if w == 0.0:
+            return 1.0, tau, 0.5 * tau * tau, tau * tau * tau / 6.0
+        sig = z * w
+        wd = w * np.sqrt(1.0 - z * z)
+        e = np.exp(-sig * tau)
+        c, s = np.cos(wd * tau), np.sin(wd * tau)
+        h = e * s / wd
+        g = e * (c + sig * s / wd)
+        x = w * tau
+        if x < 0.5:  # series, as the kernel does (cancellation in 1 - g)
+            S = 0.0
+            R = 0.0
+            a_prev, a_cur = 0.0, 0.5 * tau * tau
+            r_prev, r_cur = 0.0, tau * tau * tau / 6.0
+            S, R = a_cur, r_cur
+            tst = 2.0 * sig * tau
+            for n in range(1, 24):
+                nxt = -((n + 1) * tst * a_cur + x * x * a_prev) / ((n + 2) * (n + 1))
+                a_prev, a_cur = a_cur, nxt
+                S += nxt
+                k = n + 1
+                rn = -((k + 1) * tst * r_cur + x * x * r_prev) / ((k + 2) * (k + 1))
+                r_prev, r_cur = r_cur, rn
+                R += rn
+            return g, h, S, R
+        S = (1.0 - g) / (w * w)
+        R = (tau - h - 2.0 * sig * S) / (w * w)
+        return g, h, S, R
+
+    @numba.njit(cache=False)
+    def run(
+        omega: np.ndarray, zeta: np.ndarray, tb: np.ndarray, pb: np.ndarray, t: np.ndarray
+    ) -> np.ndarray:
+        m, nt, nb = omega.size, t.size, tb.size
+        out = np.empty((3, m, nt))
+        for j in range(m):
+            w, z = omega[j], zeta[j]
+            w2, ts = w * w, 2.0 * z * w
+            eta = 0.0
+            v = 0.0
+            p = 0.0
+            s = 0.0
+            tcur = tb[0]
+            k = 0
+            last_tau = -1.0
+            g = h = S = R = 0.0
+            for i in range(nt):
+                ti = t[i]
+                if ti < tb[0]:
+                    out[0, j, i] = 0.0
+                    out[1, j, i] = 0.0
+                    out[2, j, i] = 0.0
+                    continue
+                while k < nb and tb[k] <= ti:  # cross the breakpoints up to ti
+                    tau = tb[k] - tcur
+                    if tau > 0.0:
+                        g2, h2, S2, R2 = funcs(w, z, tau)
+                        e2 = eta * g2 + v * h2 + p * S2 + s * R2
+                        v = -w2 * h2 * eta + (g2 - ts * h2) * v + p * h2 + s * S2
+                        eta = e2
+                    tcur = tb[k]
+                    while k + 1 < nb and tb[k + 1] == tb[k]:
+                        k += 1
+                    p = pb[j, k]
+                    s = (pb[j, k + 1] - p) / (tb[k + 1] - tb[k]) if k + 1 < nb else 0.0
+                    k += 1
+                tau = ti - tcur
+                if tau > 0.0:
+                    if abs(tau - last_tau) > 1.8e-15 * max(ti, 1.0):  # 8 roundings of t
+                        g, h, S, R = funcs(w, z, tau)
+                        last_tau = tau
+                    e2 = eta * g + v * h + p * S + s * R
+                    v = -w2 * h * eta + (g - ts * h) * v + p * h + s * S
+                    eta = e2
+                    p = p + s * tau
+                    tcur = ti
+                out[0, j, i] = eta
+                out[1, j, i] = v
+                out[2, j, i] = p - ts * v - w2 * eta
+        return out
+
+    return run  # type: ignore[no-any-return]
+
+
+def rel_diff(a: np.ndarray, b: np.ndarray) -> float:
+    """Largest difference per mode (row) over that mode's peak."""
+    scale = np.max(np.abs(b), axis=-1, keepdims=True) + 1e-300
+    return float(np.max(np.abs(a - b) / scale))
 
 
 def main() -> None:
@@ -52,27 +161,78 @@ def main() -> None:
     gamma = phi.T @ b
     t = np.linspace(0.0, T_END, N_T)
     dt = t[1] - t[0]
+    force = crew_pushoff()  # Eq. 2.16 with its jumps
+    mf = np.outer(gamma, force.force)
+    piecewise = np.unique(
+        np.r_[np.arange(0.0, 50.0, 0.01), np.linspace(50.0, T_END, 7501), force.timepts]
+    )
+    print(
+        f"modes {N_MODES} ({N_RIGID} rigid), output times {N_T}, dt {dt:g} s, "
+        f"push-off f0 {force.force.max():.4g} N"
+    )
+    nb = numba_recurrence()
+    rows: list[tuple[str, float, float | None]] = []
+    with threadpool_limits(1):
+        for label, grid in (("uniform", t), ("piecewise-uniform", piecewise)):
+            t_k, mine = best_of(
+                lambda g=grid: modal_pwl_response(omega, zeta, force.timepts, mf, g)
+            )
+            t_nb = None
+            if nb is not None:
+                nb(omega, zeta, force.timepts, mf, grid[:10])  # compile
+                t_nb, ref = best_of(lambda g=grid: nb(omega, zeta, force.timepts, mf, g))
+                err = max(
+                    rel_diff(getattr(mine, k), ref[q])
+                    for q, k in enumerate(("eta", "eta_dot", "eta_ddot"))
+                )
+                print(f"  {label}: microg vs numba recurrence, max difference {err:.1e} of peak")
+            rows.append((f"modal_pwl_response, {label} ({grid.size} times)", t_k, t_nb))
+        t_pts, pts = best_of(lambda: response_at_points(omega, zeta, phi, points, force, b, t))
+        t_nbp = None
+        if nb is not None:
 
-    true_force = crew_pushoff()  # Eq. 2.16 with its jumps
-    f0 = true_force.force.max()
-    # the force lsim sees: samples of the right-continuous force joined by straight lines
+            def nb_points() -> dict[str, np.ndarray]:
+                modal = nb(omega, zeta, force.timepts, mf, t)
+                return {n: (m_ @ phi) @ modal[2] for n, m_ in points.items()}
+
+            t_nbp, ref_p = best_of(nb_points)
+            err = max(
+                float(np.max(np.abs(pts[n].acceleration - ref_p[n])) / np.max(np.abs(ref_p[n])))
+                for n in points
+            )
+            print(f"  points: microg vs numba + projection, max difference {err:.1e} of peak")
+        rows.append(("response_at_points, 3 points, uniform", t_pts, t_nbp))
+        off = crew_pushoff(t13=13.000000001, t14=14.000000001)
+        t_pk, pk = best_of(lambda: peak_response(omega, zeta, phi, points, [(off, b)], t), repeat=3)
+        rows.append(("peak_response, 3 points, jump off the grid", t_pk, None))
+    with threadpool_limits(2):
+        t_pts2, _ = best_of(lambda: response_at_points(omega, zeta, phi, points, force, b, t))
+        t_k2, _ = best_of(lambda: modal_pwl_response(omega, zeta, force.timepts, mf, t))
+    print(f"\n{'case (1 BLAS thread)':52s} {'microg':>9s} {'numba':>9s} {'ratio':>7s}")
+    for name, tm, tb_ in rows:
+        extra = f"{tb_ * 1e3:8.1f}  {tm / tb_:6.2f}x" if tb_ else f"{'-':>8s}  {'-':>7s}"
+        print(f"{name:52s} {tm * 1e3:7.1f} ms {extra}")
+    print(
+        f"(2 BLAS threads: modal_pwl_response {t_k2 * 1e3:.1f} ms, "
+        f"response_at_points {t_pts2 * 1e3:.1f} ms)"
+    )
+    for n in points:
+        p = pk[n]
+        print(
+            f"  exact peak at {n}: {p.peak_accel_mps2:.6e} m/s^2 at {p.peak_time_s:.9f} s "
+            f"({p.peak_side}); bound {p.upper_bound_mps2 / p.peak_accel_mps2 - 1:.1e} above; "
+            f"sampled {p.sampled_peak_accel_mps2:.6e} ({p.rounds} rounds)"
+        )
+
+    # --- lsim on the block-diagonal system, fed the push-off as it sees it (samples joined)
+    f0 = force.force.max()
     lsim_force = piecewise_linear(
         [0.0, 1.0 - dt, 1.0, 13.0 - dt, 13.0, 14.0],
         [0.0, f0 * (1.0 - dt), 0.0, 0.0, -f0, 0.0],
         name="push-off as sampled",
     )
     u = lsim_force.at(t)
-    assert np.allclose(u, true_force.at(t), rtol=0, atol=1e-9 * f0)  # same samples
-
-    # --- microg: modal kernel, and the full point response (kernel + projection)
-    t_kernel, mine = best_of(
-        lambda: modal_pwl_response(
-            omega, zeta, lsim_force.timepts, np.outer(gamma, lsim_force.force), t
-        )
-    )
-    t_points, pts = best_of(lambda: response_at_points(omega, zeta, phi, points, lsim_force, b, t))
-
-    # --- baseline: lsim on the block-diagonal system; outputs eta, eta', eta''
+    assert np.allclose(u, force.at(t), rtol=0, atol=1e-9 * f0)  # same samples
     A = block_diag(
         *[np.array([[0.0, 1.0], [-(w**2), -2 * z * w]]) for w, z in zip(omega, zeta, strict=True)]
     )
@@ -86,48 +246,35 @@ def main() -> None:
     C[2 * N_MODES + idx, 2 * idx] = -(omega**2)
     C[2 * N_MODES + idx, 2 * idx + 1] = -2 * zeta * omega
     D[2 * N_MODES :, 0] = gamma
-    t_lsim, (_, y, _) = best_of(lambda: signal.lsim((A, B, C, D), u, t), repeat=3)
+    with threadpool_limits(1):
+        t_lsim, (_, y, _) = best_of(lambda: signal.lsim((A, B, C, D), u, t), repeat=3)
+        t_kl, mine = best_of(
+            lambda: modal_pwl_response(
+                omega, zeta, lsim_force.timepts, np.outer(gamma, lsim_force.force), t
+            )
+        )
     ref = {"eta": y[:, :N_MODES].T, "eta_dot": y[:, N_MODES : 2 * N_MODES].T}
     ref["eta_ddot"] = y[:, 2 * N_MODES :].T
-
-    print(
-        f"modes {N_MODES} ({N_RIGID} rigid), output times {N_T}, dt {dt:g} s, "
-        f"push-off f0 {f0:.4g} N"
-    )
-    print(f"microg modal_pwl_response : {t_kernel * 1e3:8.1f} ms")
-    print(f"microg response_at_points : {t_points * 1e3:8.1f} ms  (kernel + 3 points)")
-    print(f"scipy lsim, block-diagonal: {t_lsim * 1e3:8.1f} ms")
-    print(f"speed-up (lsim / kernel)  : {t_lsim / t_kernel:8.1f} x")
+    print(f"\nscipy lsim, block-diagonal: {t_lsim * 1e3:8.1f} ms ({t_lsim / t_kl:.1f}x microg)")
     for key in ("eta", "eta_dot", "eta_ddot"):
-        r, m = ref[key], getattr(mine, key)
-        per_mode = np.max(np.abs(m - r), axis=1) / np.max(np.abs(r), axis=1)
-        print(f"max difference {key:9s}: {per_mode.max():.2e} of each mode's peak")
-    worst = 0.0
-    for name, tmap in points.items():
-        acc_ref = tmap @ phi @ ref["eta_ddot"]
-        diff = np.max(np.abs(pts[name].acceleration - acc_ref)) / np.max(np.abs(acc_ref))
-        worst = max(worst, diff)
-    print(f"max difference, point accelerations: {worst:.2e} of the peak")
-
-    exact = response_at_points(omega, zeta, phi, points, true_force, b, t)
-    acc_true = exact["p1"].acceleration
+        print(f"max difference {key:9s}: {rel_diff(getattr(mine, key), ref[key]):.2e} of peak")
+    exact = response_at_points(omega, zeta, phi, points, force, b, t)
     acc_lsim = points["p1"] @ phi @ ref["eta_ddot"]
-    err = np.max(np.abs(acc_lsim - acc_true)) / np.max(np.abs(acc_true))
-    print(f"(lsim on the true push-off with jumps is off by {err:.1e} of the peak at p1)")
+    err = np.max(np.abs(acc_lsim - exact["p1"].acceleration))
+    print(f"(lsim on the true push-off with jumps is off by {err / np.abs(acc_lsim).max():.1e})")
 
     if importlib.util.find_spec("pyyeti") is None:
         print("pyyeti: not installed, comparison skipped")
     else:  # pragma: no cover - optional
         from pyyeti import ode
 
-        k = omega**2
-        c = 2 * zeta * omega
-        m_ = np.ones(N_MODES)
-        force = np.outer(gamma, u)
-        ts = ode.SolveUnc(m_, c, k, dt, rf=None)
-        t_yeti, sol = best_of(lambda: ts.tsolve(force), repeat=3)
-        d = np.max(np.abs(sol.d - ref["eta"]), axis=1) / np.max(np.abs(ref["eta"]), axis=1)
-        print(f"pyyeti SolveUnc.tsolve    : {t_yeti * 1e3:8.1f} ms, max diff {d.max():.2e}")
+        ts = ode.SolveUnc(np.ones(N_MODES), 2 * zeta * omega, omega**2, dt, rf=None)
+        with threadpool_limits(1):
+            t_yeti, sol = best_of(lambda: ts.tsolve(np.outer(gamma, u)), repeat=3)
+        print(
+            f"pyyeti SolveUnc.tsolve    : {t_yeti * 1e3:8.1f} ms, max diff "
+            f"{rel_diff(sol.d, ref['eta']):.2e}"
+        )
 
 
 if __name__ == "__main__":

@@ -454,6 +454,29 @@ def test_issue9_peak_with_off_grid_jump_equals_on_grid_peak():
     assert sampled_loss > 5e-3
 
 
+def test_issue9_on_the_shipped_ioc_model():
+    """Issue 9 as stated, on the shipped IOC model (3-D assumed modes, 2 per beam, zeta 0.01):
+    the lab's sampled peak drops by about 0.9 % when the landing moves 1e-9 s off the grid;
+    the exact peak does not move."""
+    from microg.dynamics.modes import solve_modes
+    from microg.models.toml import load_station
+    from microg.structure.discretize import discretize
+
+    s = discretize(load_station("ioc"), "ritz", n=2)
+    m = solve_modes(s)
+    zeta = np.where(m.rigid, 0.0, 0.01)
+    t = np.arange(0.0, 200.0 + 0.005, 0.01)
+    maps = {"lab": s.point("lab").translation}
+    b = generalized_force_vector(s.point("crew").translation, np.array([1.0, 0.0, 0.0]))
+    on = peak_response(m.omega, zeta, m.phi, maps, [(crew_pushoff(), b)], t)["lab"]
+    off_f = crew_pushoff(t13=13.000000001, t14=14.000000001)
+    off = peak_response(m.omega, zeta, m.phi, maps, [(off_f, b)], t)["lab"]
+    # a 1e-9 s shift moves the true peak by ~omega_max 1e-9 (omega <= 550 rad/s): 1e-6 bound
+    assert off.peak_accel_mps2 == pytest.approx(on.peak_accel_mps2, rel=1e-6)
+    loss = 1.0 - off.sampled_peak_accel_mps2 / off.peak_accel_mps2
+    assert 0.005 < loss < 0.015  # the issue's 0.9 %: sampling alone would fail this test
+
+
 def test_peak_against_dense_brute_force_evaluation():
     """Off-grid peaks: peak_response on a coarse 0.25 s grid against a 2e-4 s dense evaluation."""
     omega, zeta, phi, maps, b = _small_model(seed=5)

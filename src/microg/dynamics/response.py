@@ -701,6 +701,56 @@ def response_at_points(
 
 # --------------------------------------------------------------------------- exact peaks
 
+
+def _accel_coefficients(st: _State, seg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``a = Re(X exp(lambda tau))`` on segments ``seg``: X (m, n) complex; rigid rows separate.
+
+    For an elastic mode a(tau) = a_k g + j_k h = Re E a_k + Im E (sigma a_k + j_k)/omega_d with
+    E = exp(lambda tau), lambda = -sigma + i omega_d; so X = a_k - i (sigma a_k + j_k)/omega_d.
+    Rigid rows (omega = 0) get X = 0 here; their a = a_k + j_k tau is added by the callers.
+    """
+    sigma = (st.zeta * st.omega)[:, None]
+    omega_d = (st.omega * np.sqrt(1.0 - st.zeta * st.zeta))[:, None]
+    acc, jerk = st.acc[:, seg], st.jerk[:, seg]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        cs = np.where(omega_d > 0, (sigma * acc + jerk) / omega_d, 0.0)
+    cc = np.where(omega_d > 0, acc, 0.0)
+    return cc - 1j * cs, np.flatnonzero(st.omega == 0)
+
+
+def _lam(st: _State) -> np.ndarray:
+    return (-st.zeta * st.omega + 1j * st.omega * np.sqrt(1.0 - st.zeta * st.zeta))[:, None]
+
+
+def _accel_direct(st: _State, seg: np.ndarray, tau: np.ndarray) -> np.ndarray:
+    """Modal accelerations (m, n) at elapsed times ``tau`` into segments ``seg`` (>= 0)."""
+    X, rigid = _accel_coefficients(st, seg)
+    out = (X * np.exp(_lam(st) * tau[None, :])).real
+    if rigid.size:
+        out[rigid] = st.acc[rigid][:, seg] + st.jerk[rigid][:, seg] * tau[None, :]
+    return out
+
+
+def _accel_sub(
+    st: _State, seg: np.ndarray, tau_a: np.ndarray, delta: float, nsub: int
+) -> np.ndarray:
+    """Modal accelerations (m, n, nsub - 1) at ``tau_a + r delta``, r = 1 .. nsub - 1.
+
+    One exponential per interval and one small table ``exp(lambda r delta)`` shared by all
+    intervals of this length: a complex product per value.
+    """
+    X, rigid = _accel_coefficients(st, seg)
+    lam = _lam(st)
+    XA = X * np.exp(lam * tau_a[None, :])  # (m, n)
+    rd = np.arange(1, nsub) * delta
+    W = np.exp(lam * rd[None, :])  # (m, nsub - 1)
+    out = XA.real[:, :, None] * W.real[:, None, :] - XA.imag[:, :, None] * W.imag[:, None, :]
+    if rigid.size:
+        tt = tau_a[None, :, None] + rd[None, None, :]
+        out[rigid] = (st.acc[rigid][:, seg])[:, :, None] + (st.jerk[rigid][:, seg])[:, :, None] * tt
+    return out
+
+
 #: each refinement round cuts every interval that may still hold a higher value into this many
 _SUBDIVIDE = 16
 #: new evaluation times per vectorised batch in the refinement (bounds the scratch memory)
@@ -920,8 +970,32 @@ def peak_response(
         for c0 in range(0, ok.size, _PEAK_BATCH):
             idx = ok[c0 : c0 + _PEAK_BATCH]
             sg = seg[idx]
-            res[:, idx] = proj @ _direct(st, sg, tt[idx] - starts[sg], (2,))[0]
+            res[:, idx] = proj @ _accel_direct(st, sg, tt[idx] - starts[sg])
         return res
+
+    def accel_sub(sg: np.ndarray, ta: np.ndarray, tb_: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Times (na, S-1) cutting each interval into S equal parts, and the values there."""
+        h = tb_ - ta
+        scale = 1e-12 * max(abs(t_lo), abs(t_hi), 1.0)
+        keys = np.rint(h / scale)
+        tn = np.empty((ta.size, _SUBDIVIDE - 1))
+        vn = np.empty((proj.shape[0], ta.size, _SUBDIVIDE - 1))
+        _, inv = np.unique(keys, return_inverse=True)
+        inv = inv.reshape(-1)
+        for g in range(int(inv.max(initial=-1)) + 1):
+            grp = np.flatnonzero(inv == g)
+            delta = float(h[grp].mean()) / _SUBDIVIDE
+            rd = np.arange(1, _SUBDIVIDE) * delta
+            step = max(1, _PEAK_BATCH // (_SUBDIVIDE - 1))
+            for c0 in range(0, grp.size, step):
+                idx = grp[c0 : c0 + step]
+                tau_a = ta[idx] - starts[sg[idx]]
+                modal = _accel_sub(st, sg[idx], tau_a, delta, _SUBDIVIDE)
+                vn[:, idx] = (proj @ modal.reshape(modal.shape[0], -1)).reshape(
+                    proj.shape[0], idx.size, -1
+                )
+                tn[idx] = ta[idx, None] + rd
+        return tn, vn
 
     # 1. samples: the output grid (right-continuous values) and the one-sided limits at jumps
     grid_vals = _evaluate(st, t, (2,), proj)[0]  # (R, nt)
@@ -988,10 +1062,7 @@ def peak_response(
         if keep.size == 0 or rounds >= max_rounds:
             break
         rounds += 1
-        frac = np.arange(1, _SUBDIVIDE) / _SUBDIVIDE
-        tn = ta[:, None] + (tb_ - ta)[:, None] * frac  # (na, S-1)
-        sn = np.broadcast_to(sg[:, None], tn.shape)
-        vn = accel(sn.ravel(), tn.ravel()).reshape(proj.shape[0], *tn.shape)
+        tn, vn = accel_sub(sg, ta, tb_)  # (na, S-1), (R, na, S-1)
         # new best values
         an = np.abs(vn).reshape(proj.shape[0], -1)
         i_ax = an.argmax(axis=1)
