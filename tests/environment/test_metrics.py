@@ -217,6 +217,8 @@ def test_unresolved_exceedance_is_warned_not_judged():
     res = assess(TIME, a[None, :], transient=None)
     assert res.complies is True  # every resolved band is clean
     assert any("not judged" in w and "0.0197" in w for w in res.warnings)
+    # the 0.02 Hz bin is shared by the 0.0156, 0.0197 and 0.0248 Hz bands (df = 0.01 Hz)
+    assert 0.0197 in res.to_dict()["third_octave"]["unresolved_exceeding_hz"]
 
 
 def test_pims_steps_are_the_ssp_curve_near_the_upper_edge():
@@ -438,3 +440,17 @@ def test_plots_return_figures_and_steps_on_band_edges():
     to = res.third_octave
     assert np.allclose(x[0::2], to.lower_hz) and np.allclose(x[1::2], to.upper_hz)
     assert np.allclose(y[0::2], to.limit_g * 1e6) and np.allclose(y[1::2], to.limit_g * 1e6)
+
+
+def test_overlay_of_a_prediction_and_a_measurement():
+    from microg.plotting.environment import plot_overlay
+
+    pred = assess(TIME, np.vstack([1e-5 * np.sin(2 * np.pi * 2.0 * TIME), 0 * TIME, 0 * TIME]))
+    rng = np.random.default_rng(2)
+    meas = assess(TIME, 1e-6 * rng.standard_normal((3, TIME.size)), transient_basis="pims")
+    fig = plot_overlay(pred, meas, labels=("IOC lab", "SAMS 121f03"))
+    assert isinstance(fig, Figure) and len(fig.axes) == 2
+    labels = [ln.get_label() for ln in fig.axes[0].lines]
+    assert {"IOC lab x", "SAMS 121f03 x", "limit"} <= set(labels)
+    assert len(fig.axes[1].lines) == 2  # one PSD each, the worst axis by RMS
+    assert isinstance(pred.plot("psd"), Figure)

@@ -375,6 +375,9 @@ class Assessment:
                 "n_bins": _numbers(to.n_bins),
                 "coverage": _numbers(to.coverage),
                 "unresolved_bands": self.unresolved_bands,
+                "unresolved_exceeding_hz": _numbers(
+                    to.center_hz[~to.judged & np.any(to.rms_g > to.limit_g, axis=0)]
+                ),
                 "verdict_bands_hz": _numbers(self.verdict_bands_hz),
                 "verdict_range_hz": None if vr is None else list(vr),
             },
