@@ -169,6 +169,8 @@ BAD = [
     (["locate", "ioc", "--crew", "crew", "--direction", "w"], "--direction"),
     (["locate", "ioc", "--crew", "crew", "--damping", "1.5"], "--damping"),
     (["locate", "ioc", "--crew", "crew", "--f0", "3 m"], "--f0"),
+    (["locate", "ioc", "--f0", "0 lbf"], "--f0"),
+    (["optimize", "ioc", "--t14", "12 s", "--movable", "Horizontal lab=-91ft:-5ft"], "--t14"),
     (["locate", "ioc", "--crew", "crew", "--on", "hull"], "--on: no samples on 'hull'"),
     (["locate", "ioc", "--crew", "crew", "--on", "hull"], "known components"),
     (["locate", "ioc", "--elements", "3"], "--elements"),

@@ -460,7 +460,8 @@ def optimize(
     from microg.location.layout import optimize_layout
     from microg.models.toml import load_station
 
-    crew = _crew(f0, t1, t13, t14)
+    with _as_flags():
+        crew = _crew(f0, t1, t13, t14)
     station = load_station(model)
     overrides = {name: (lo, hi) for name, lo, hi in movable}
     bar = tqdm(

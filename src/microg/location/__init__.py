@@ -1,1 +1,49 @@
-"""location stage of microg (see docs/architecture.md)."""
+"""Where to put the laboratory: acceleration maps, nodes of the fundamental, layout optimiser.
+
+The report's conclusions 6, 7 and 9 (Section 5, Figure 9).  Modules, one concept each:
+:mod:`~microg.location.sampling` (samples along the structure, straight lines, nodes),
+:mod:`~microg.location.peaks` (Eq. 3.1 peak factors, the rigid-body part, the time grid, the
+elastic rule), :mod:`~microg.location.amap` (the acceleration map, the peaks at one point,
+the best location, :func:`locate`), :mod:`~microg.location.layout` (movable masses and the
+optimiser); figures in :mod:`microg.plotting.location`, the conclusion-7 reproduction in
+:mod:`microg.seed.conclusion7`.  See ``docs/locate.md``.
+"""
+
+from microg.location.amap import (
+    AccelerationMap,
+    LocateResult,
+    Location,
+    SitePeak,
+    acceleration_map,
+    best_location,
+    locate,
+    point_peak,
+)
+from microg.location.layout import (
+    LayoutResult,
+    MovableMass,
+    layout_objective,
+    movable_masses,
+    move_masses,
+    optimize_layout,
+)
+from microg.location.sampling import Node, SampleLine
+
+__all__ = [
+    "AccelerationMap",
+    "LayoutResult",
+    "LocateResult",
+    "Location",
+    "MovableMass",
+    "Node",
+    "SampleLine",
+    "SitePeak",
+    "acceleration_map",
+    "best_location",
+    "layout_objective",
+    "locate",
+    "movable_masses",
+    "move_masses",
+    "optimize_layout",
+    "point_peak",
+]
