@@ -54,7 +54,7 @@ FLAGS = {
     "--segment",
     type=QuantityType("time", "s", minimum=0.0, strict=True),
     default=None,
-    help="Welch segment length. [default: the interval]",
+    help="Welch segment length. [default: each interval, and the whole record for its PSD]",
 )
 @click.option(
     "--transient",
