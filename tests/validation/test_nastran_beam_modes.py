@@ -35,7 +35,10 @@ FIXTURE = Path(__file__).resolve().parents[3] / "shared" / "fixtures" / "nastran
 DECK = FIXTURE / "beam_modes.dat"
 F06 = FIXTURE / "beam_modes.f06"
 
-pytestmark = pytest.mark.skipif(not DECK.is_file(), reason="shared NASTRAN fixture not present")
+pytestmark = [
+    pytest.mark.nastran,
+    pytest.mark.skipif(not DECK.is_file(), reason="shared NASTRAN fixture not present"),
+]
 
 
 def _f06_eigenvalues() -> np.ndarray:

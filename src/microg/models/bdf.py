@@ -24,7 +24,8 @@ other card is *unsupported* and the whole deck is refused with one :class:`Input
 each unsupported card with its count.  Nothing is dropped silently.
 
 **Units.**  NASTRAN decks declare none: ``units="LENGTH, FORCE, TIME"`` is required (e.g.
-``"in, lbf, s"``, ``"mm, N, s"``, ``"m, N, s"``); the mass unit is FORCE TIME^2 / LENGTH.  Mass
+``"in, lbf, s"``, ``"mm, N, s"``, ``"m, N, s"``; :func:`microg.models.modal.parse_units`);
+the mass unit is FORCE TIME^2 / LENGTH.  Mass
 input (densities, non-structural mass, CONM2) is multiplied by WTMASS (``PARAM,WTMASS``, or
 the ``wtmass`` argument; both given and different is an error).
 
@@ -35,10 +36,11 @@ the PBARL/PBEAML section (:data:`SECTION_SHEAR_FACTORS`); see :mod:`microg.struc
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import re
 from collections import Counter
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -54,6 +56,7 @@ from microg.models.graph import (
     Constraint,
     CoordinateFrame,
     GraphModel,
+    GraphPoint,
     Interpolation,
     Node,
     RigidLink,
@@ -65,6 +68,7 @@ from microg.models.graph import (
     spring_axes,
     validate_graph,
 )
+from microg.models.modal import ModalPoint, UnitSystem, parse_units
 
 __all__ = [
     "IGNORED_CARDS",
@@ -75,7 +79,6 @@ __all__ = [
     "Card",
     "load_bdf",
     "read_cards",
-    "unit_scales",
 ]
 
 # fmt: off
@@ -254,24 +257,32 @@ def _read_lines(path: Path, shown: str, depth: int, stack: tuple[Path, ...]) -> 
         yield _Line(line, shown, number)
 
 
-def _fields_of(line: str, first: bool) -> tuple[str | None, list[str], bool]:
-    """(name or None for a continuation, data fields, large-field) of one physical line."""
+def _free(parts: list[str], large: bool, where: str) -> list[str]:
+    """Data fields of a free-field line (after its first field): 8 (4 large), then a marker."""
+    per = 4 if large else 8
+    data = parts[1:]
+    if len(data) > per + 1 or (len(data) == per + 1 and isinstance(_value(data[per]), int | float)):
+        raise InputError(
+            f"a free-field line holds {per} data fields and a continuation marker, "
+            f"this one has {len(data)} fields",
+            where=where,
+            fix="continue the card on a new line starting with '+' (or ',')",
+        )
+    return data[:per]
+
+
+def _fields_of(line: str, where: str) -> tuple[str, list[str]]:
+    """(name, data fields) of the first line of a card."""
     if "," in line:
         parts = line.split(",")
         head = parts[0].strip()
-        large = head.endswith("*")
-        data = parts[1:]
-        per = 4 if large else 8
-        if len(data) > per:  # the field after the data is a continuation marker
-            data = data[:per] + data[per + 1 :]
-        return (None if not first else head.rstrip("*")), data, large
+        return head.rstrip("*"), _free(parts, head.endswith("*"), where)
     head = line[:8]
-    large = head.strip().endswith("*")
-    if large:
+    if head.strip().endswith("*"):
         data = [line[8 + 16 * k : 24 + 16 * k] for k in range(4)]
     else:
         data = [line[8 + 8 * k : 16 + 8 * k] for k in range(8)]
-    return (None if not first else head.strip().rstrip("*")), data, large
+    return head.strip().rstrip("*"), data
 
 
 def _is_continuation(line: str) -> bool:
@@ -330,14 +341,11 @@ def read_cards(path: str | Path) -> tuple[list[Card], list[str]]:
             continue
         if re.match(r"\s*ENDDATA\b", text, re.I):
             break
+        where = f"{ln.file}:{ln.number}"
         if cur is not None and _is_continuation(text):
             if "," in text:
                 parts = text.split(",")
-                large = parts[0].strip().startswith("*")
-                data = parts[1:]
-                per = 4 if large else 8
-                if len(data) > per:
-                    data = data[:per] + data[per + 1 :]
+                data = _free(parts, parts[0].strip().startswith("*"), where)
             else:
                 large = text.startswith("*")
                 data = (
@@ -351,8 +359,7 @@ def read_cards(path: str | Path) -> tuple[list[Card], list[str]]:
             cards.append(_card(cur, cur_at))
         if len(cards) >= MAX_CARDS:
             raise InputError(f"more than {MAX_CARDS} cards", where=shown, fix="split the model")
-        name, data, _ = _fields_of(text, True)
-        assert name is not None
+        name, data = _fields_of(text, where)
         cur = [name.strip().upper(), *(_value(f) for f in data)]
         cur_at = (ln.file, ln.number)
     if cur is not None:
@@ -378,33 +385,6 @@ class _Scales:
     @property
     def mass(self) -> float:
         return self.force * self.time**2 / self.length
-
-
-def unit_scales(units: str | None, *, where: str = "units") -> tuple[float, float, float]:
-    """SI values of the deck's length, force and time units from ``"LENGTH, FORCE, TIME"``.
-
-    ``"in, lbf, s"`` -> (0.0254, 4.448..., 1.0).  A missing declaration is an error (NASTRAN
-    files declare none); each unit is checked for its dimension.
-    """
-    from microg.units import parse_quantity
-
-    if units is None or not str(units).strip():
-        raise InputError(
-            "NASTRAN files declare no units and none were given",
-            where=where,
-            fix='state them as "LENGTH, FORCE, TIME", e.g. units="in, lbf, s" '
-            "(and wtmass if the deck's masses are weights)",
-        )
-    parts = [u.strip() for u in str(units).split(",")]
-    if len(parts) != 3 or not all(parts):
-        raise InputError(
-            f"expected three units LENGTH, FORCE, TIME, got {units!r}",
-            where=where,
-            fix='write e.g. "in, lbf, s" or "mm, N, s"',
-        )
-    dims = ("length", "force", "time")
-    out = tuple(parse_quantity(f"1 {u}", d, where=where) for u, d in zip(parts, dims, strict=True))
-    return out[0], out[1], out[2]
 
 
 # --------------------------------------------------------------------------- sections
@@ -1344,10 +1324,11 @@ class _Deck:
 
 def load_bdf(
     path: str | Path,
-    units: str | None = None,
+    units: str | UnitSystem | None = None,
     *,
     wtmass: float | None = None,
     spc: int | None = None,
+    points: Sequence[ModalPoint] | None = None,
 ) -> GraphModel:
     """Read a NASTRAN bulk data deck into a graph model, SI.
 
@@ -1355,14 +1336,17 @@ def load_bdf(
     ----------
     path : str or Path
         The deck; INCLUDE files are read relative to it.
-    units : str
-        ``"LENGTH, FORCE, TIME"`` of the deck, e.g. ``"in, lbf, s"`` (required: NASTRAN files
-        declare none).
+    units : str or UnitSystem
+        ``"LENGTH, FORCE, TIME"`` of the deck, e.g. ``"in, lbf, s"``
+        (:func:`microg.models.modal.parse_units`); required: NASTRAN files declare none.
     wtmass : float, optional
         Factor from the deck's mass input to FORCE TIME^2/LENGTH (NASTRAN ``PARAM,WTMASS``);
-        default the deck's, else 1.  Contradicting the deck's is an error.
+        default the deck's, else 1.  Contradicting the deck's is an error.  (A UnitSystem's
+        ``wtmass`` other than 1 counts as given.)
     spc : int, optional
         SPC set noted as the model's constraints; default the case control's ``SPC = n``.
+    points : sequence of ModalPoint, optional
+        Named points on grids (a points file, :func:`microg.models.modal.read_options`).
 
     Returns
     -------
@@ -1371,7 +1355,35 @@ def load_bdf(
         (not applied unless :func:`~microg.structure.frame.build_frame` is asked to);
         ``meta`` the units, WTMASS, ignored cards and parameters, and ``warnings``.
     """
-    length, force, time = unit_scales(units, where="units")
+    if isinstance(units, UnitSystem):
+        system = units
+        if wtmass is None and units.wtmass != 1.0:
+            wtmass = units.wtmass
+    elif units is None or not str(units).strip():
+        raise InputError(
+            "NASTRAN files declare no units and none were given",
+            where=str(path),
+            fix='state them as "LENGTH, FORCE, TIME", e.g. units="in, lbf, s" '
+            "(and wtmass if the deck's masses are weights)",
+        )
+    else:
+        system = parse_units(str(units), where="units")
     cards, case = read_cards(path)
-    deck = _Deck(cards, case, str(path), _Scales(length, force, time), wtmass, spc)
-    return deck.build()
+    sc = _Scales(system.length_m, system.force_N, system.time_s)
+    deck = _Deck(cards, case, str(path), sc, wtmass, spc)
+    graph = deck.build()
+    if not points:
+        return graph
+    out = []
+    for p in points:
+        node = f"grid:{p.grid}"
+        try:
+            pos = graph.node(node).position
+        except InputError as exc:
+            raise InputError(
+                f"point {p.name!r}: grid {p.grid} is not in the deck", where=str(path), fix=exc.fix
+            ) from None
+        out.append(
+            GraphPoint(p.name, node, pos + np.asarray(p.offset_m, float), p.kind, p.description)
+        )
+    return dataclasses.replace(graph, points=tuple(out))
