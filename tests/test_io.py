@@ -1,17 +1,39 @@
-"""Output helpers: atomic writes, output directories, JSON of results."""
+"""Output helpers: run directories written as a whole, single files, file names, JSON.
+
+The run-directory tests reproduce issue 10 section 5: a kill mid-run must leave the previous
+run or the new one, never a mix; disk full and errors leave the previous run; stale figures
+disappear; a directory microg did not write is never replaced; point names that collide
+after sanitising get distinct files.
+"""
 
 from __future__ import annotations
 
+import errno
 import json
 import os
+import random
+import signal
 import stat
+import subprocess
+import sys
+import textwrap
+import time
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from microg._io import atomic_write_text, dumps, write_output_files
+import microg._io as io_mod
+from microg._io import (
+    RUN_MARKER,
+    atomic_write_text,
+    check_writable,
+    dumps,
+    safe_filenames,
+    write_output_files,
+    write_run_directory,
+)
 from microg.errors import InputError
 
 
@@ -26,20 +48,88 @@ def test_atomic_write_replaces_and_leaves_no_temporaries(tmp_path: Path) -> None
     assert stat.S_IMODE(p.stat().st_mode) == 0o666 & ~umask  # not mkstemp's 0600
 
 
-def test_output_files_keep_other_content(tmp_path: Path) -> None:
+def _listing(path: Path) -> list[str]:
+    return sorted(p.name for p in path.iterdir())
+
+
+def test_run_directory_is_replaced_whole_and_stale_figures_go(tmp_path: Path) -> None:
+    out = tmp_path / "run"
+    write_run_directory(out, {"report.html": "old", "lab-isolated.png": b"old"}, where="out")
+    assert _listing(out) == [RUN_MARKER, "lab-isolated.png", "report.html"]
+    # the next run needs no isolation: its directory has no lab-isolated.png (issue 10 sec. 5)
+    write_run_directory(out, {"report.html": "new", "results.json": "{}"}, where="out")
+    assert _listing(out) == [RUN_MARKER, "report.html", "results.json"]
+    assert (out / "report.html").read_text() == "new"
+    assert _listing(tmp_path) == ["run"]  # no temporary sibling left
+    marker = json.loads((out / RUN_MARKER).read_text())
+    assert marker["files"] == ["report.html", "results.json"]
+    umask = os.umask(0)
+    os.umask(umask)
+    assert stat.S_IMODE(out.stat().st_mode) == 0o777 & ~umask  # not mkdtemp's 0700
+
+
+def test_write_output_files_is_the_run_writer(tmp_path: Path) -> None:
+    assert write_output_files is write_run_directory  # the name the commands use
+    write_output_files(tmp_path / "o", {"a/b.txt": "x"}, where="out")  # subdirectories too
+    assert (tmp_path / "o" / "a" / "b.txt").read_text() == "x"
+
+
+def test_refuses_a_non_empty_directory_microg_did_not_write(tmp_path: Path) -> None:
     (tmp_path / "notes.txt").write_text("mine")
-    write_output_files(tmp_path, {"r.json": "{}", "f.png": b"\x89PNG"}, where="--out")
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["f.png", "notes.txt", "r.json"]
-    assert (tmp_path / "notes.txt").read_text() == "mine"
+    with pytest.raises(InputError, match=f"no {RUN_MARKER} marker") as exc:
+        write_run_directory(tmp_path, {"r.json": "{}"}, where="--out")
+    assert exc.value.where == "--out"
+    assert _listing(tmp_path) == ["notes.txt"] and (tmp_path / "notes.txt").read_text() == "mine"
+    with pytest.raises(InputError, match="marker"):
+        check_writable(tmp_path, "--out")  # the same answer before any computation
+
+
+def test_an_empty_directory_is_taken(tmp_path: Path) -> None:
+    out = tmp_path / "empty"
+    out.mkdir()
+    write_run_directory(out, {"r.json": "{}"}, where="out")
+    assert _listing(out) == [RUN_MARKER, "r.json"]
 
 
 def test_output_path_that_is_a_file(tmp_path: Path) -> None:
     f = tmp_path / "x"
     f.write_text("file")
     with pytest.raises(InputError, match="not a directory") as exc:
-        write_output_files(f, {"r.json": "{}"}, where="--out")
+        write_run_directory(f, {"r.json": "{}"}, where="--out")
     assert exc.value.where == "--out"
     assert f.read_text() == "file"
+
+
+@pytest.mark.parametrize("bad", ["", "   ", ".", ".."])
+def test_out_empty_or_current_directory_is_an_error(bad: str, tmp_path: Path, monkeypatch) -> None:
+    # `--out ''` wrote into the current directory
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "keep").write_text("x")
+    for call in (
+        lambda: check_writable(bad, "--out"),
+        lambda: write_run_directory(bad, {"r.json": "{}"}, where="--out"),
+    ):
+        with pytest.raises(InputError) as exc:
+            call()
+        assert exc.value.where == "--out"
+    assert _listing(tmp_path) == ["keep"]
+
+
+def test_check_writable_proc_fails_at_once() -> None:
+    # `--out /proc/x` failed only after the computation
+    with pytest.raises(InputError, match="cannot write in '/proc'") as exc:
+        check_writable("/proc/x", "--out")
+    assert "\n" not in str(exc.value)
+    with pytest.raises(InputError):
+        check_writable("/proc/x.png", "--out", directory=False)
+
+
+def test_check_writable_creates_nothing(tmp_path: Path) -> None:
+    target = tmp_path / "a" / "b" / "run"
+    assert check_writable(target, "out") == target
+    assert _listing(tmp_path) == []  # the probe is removed, no parent is created
+    with pytest.raises(InputError, match="is a directory"):
+        check_writable(tmp_path, "out", directory=False)
 
 
 def test_unwritable_directory_is_one_line_and_cleans_up(tmp_path: Path) -> None:
@@ -50,8 +140,137 @@ def test_unwritable_directory_is_one_line_and_cleans_up(tmp_path: Path) -> None:
         locked.mkdir(mode=0o500)
         target = locked / "out"
     with pytest.raises(InputError) as exc:
-        write_output_files(target, {"a.txt": "x"}, where="--out")
+        write_run_directory(target, {"a.txt": "x"}, where="--out")
     assert "\n" not in str(exc.value) and exc.value.where == "--out"
+
+
+def test_disk_full_keeps_the_previous_run(tmp_path: Path, monkeypatch) -> None:
+    out = tmp_path / "run"
+    write_run_directory(out, {"a.png": b"old-a", "report.html": "old"}, where="out")
+    real_open = open
+    calls = {"n": 0}
+
+    def full_disk(file, mode="r", *args, **kwargs):  # the second file finds the disk full
+        if "x" in mode:
+            calls["n"] += 1
+            if calls["n"] == 2:
+                raise OSError(errno.ENOSPC, "No space left on device", str(file))
+        return real_open(file, mode, *args, **kwargs)
+
+    monkeypatch.setattr(io_mod, "open", full_disk, raising=False)
+    with pytest.raises(InputError, match="No space left on device") as exc:
+        write_run_directory(out, {"a.png": b"new-a", "report.html": "new"}, where="--out")
+    assert exc.value.where == "--out" and "\n" not in str(exc.value)
+    assert (out / "a.png").read_bytes() == b"old-a" and (out / "report.html").read_text() == "old"
+    assert _listing(tmp_path) == ["run"]  # the temporary directory is gone
+
+
+def test_disk_full_on_a_first_run_leaves_nothing(tmp_path: Path, monkeypatch) -> None:
+    def full_disk(file, mode="r", *args, **kwargs):
+        raise OSError(errno.ENOSPC, "No space left on device", str(file))
+
+    monkeypatch.setattr(io_mod, "open", full_disk, raising=False)
+    with pytest.raises(InputError, match="No space"):
+        write_run_directory(tmp_path / "deep" / "run", {"a": "x"}, where="out")
+    assert _listing(tmp_path) == []  # not even the parent it created
+
+
+def test_without_atomic_exchange_the_fallback_works(tmp_path: Path, monkeypatch) -> None:
+    monkeypatch.setattr(io_mod, "_exchange", lambda a, b: False)  # non-Linux systems
+    out = tmp_path / "run"
+    write_run_directory(out, {"a": "1", "b": "1"}, where="out")
+    write_run_directory(out, {"a": "2"}, where="out")
+    assert _listing(out) == [RUN_MARKER, "a"] and (out / "a").read_text() == "2"
+    assert _listing(tmp_path) == ["run"]
+
+
+_CHILD = textwrap.dedent(
+    """
+    import sys
+    from microg._io import write_run_directory
+    out, start = sys.argv[1], int(sys.argv[2])
+    payload = 400_000
+    for k in range(start, start + 10_000):
+        files = {f"fig{i}.png": (f"{k:08d}".encode() * (payload // 8)) for i in range(6)}
+        files["report.html"] = f"{k:08d}" * (payload // 8)
+        write_run_directory(out, files, where="out")
+        print(k, flush=True)
+    """
+)
+
+
+def _check_complete(out: Path) -> int | None:
+    """The run id of ``out`` when it is one complete run (all files from the same run)."""
+    if not out.exists():
+        return None
+    names = set(_listing(out))
+    marker = json.loads((out / RUN_MARKER).read_text())
+    assert names == {RUN_MARKER, *marker["files"]}  # exactly the files of its run
+    ids = {(out / n).read_bytes()[:8] for n in marker["files"]}
+    assert len(ids) == 1, f"mixed runs: {ids}"  # never new figures beside an old report
+    return int(ids.pop())
+
+
+@pytest.mark.slow
+def test_killed_at_random_points_leaves_one_complete_run(tmp_path: Path) -> None:
+    # issue 10 sec. 5: kills mixed runs (8 of 20 trials) and left temporaries (33 of 76)
+    out = tmp_path / "run"
+    rng = random.Random(20261201)  # fixed seed: reproducible kill times
+    last = None
+    for trial in range(12):
+        sig = signal.SIGKILL if trial % 3 else signal.SIGTERM
+        proc = subprocess.Popen(
+            [sys.executable, "-c", _CHILD, str(out), str(trial * 10_000)],
+            stdout=subprocess.PIPE,
+            text=True,
+        )
+        assert proc.stdout is not None
+        proc.stdout.readline()  # at least one run written, so a previous run exists
+        time.sleep(rng.uniform(0.0, 0.15))
+        proc.send_signal(sig)
+        proc.wait(timeout=30)
+        proc.stdout.close()
+        run_id = _check_complete(out)
+        assert run_id is not None and run_id >= trial * 10_000
+        leftovers = [n for n in _listing(tmp_path) if n != "run"]
+        if sig == signal.SIGTERM:
+            assert leftovers == []  # cleaned up on the way out
+        last = run_id
+    assert last is not None
+    # a SIGKILL can leave one hidden temporary; the next run into the same place removes it
+    write_run_directory(out, {"report.html": "final"}, where="out")
+    assert _listing(tmp_path) == ["run"]
+    assert _listing(out) == [RUN_MARKER, "report.html"]
+
+
+def test_stale_temporaries_of_live_processes_are_kept(tmp_path: Path) -> None:
+    out = tmp_path / "run"
+    mine = tmp_path / f".run.microg-tmp-{os.getpid()}-abc"  # a concurrent run (alive)
+    mine.mkdir()
+    (mine / RUN_MARKER).write_text("{}")
+    dead = tmp_path / ".run.microg-tmp-999999999-abc"  # no such process
+    dead.mkdir()
+    (dead / RUN_MARKER).write_text("{}")
+    notours = tmp_path / ".run.microg-tmp-999999999-xyz"
+    notours.mkdir()
+    (notours / "data.txt").write_text("not a run")  # no marker: left alone
+    write_run_directory(out, {"a": "1"}, where="out")
+    assert mine.exists() and not dead.exists() and notours.exists()
+
+
+def test_safe_filenames_a_slash_b_and_a_underscore_b() -> None:
+    # points "a/b" and "a_b" both wrote a_b-*.png, and the report showed one figure for both
+    names = safe_filenames(["a/b", "a_b", "lab", "crew site", "Lab", "..", ""])
+    stems = list(names.values())
+    assert len({s.lower() for s in stems}) == len(stems)  # unique, also without case
+    assert names["a_b"] == "a_b" and names["a/b"].startswith("a_b-")
+    assert all(s and s[0] not in ".-" and len(s) <= 80 for s in stems)
+    assert all(set(s) <= set("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-")
+               for s in stems)  # fmt: skip
+    # stable: the same names in another order give the same files
+    again = safe_filenames(["", "..", "Lab", "crew site", "lab", "a_b", "a/b"])
+    assert again == names
+    assert safe_filenames(["lab"]) == {"lab": "lab"}  # a safe name is its own file
 
 
 def test_dumps_handles_dataclasses_arrays_and_nan() -> None:

@@ -7,9 +7,10 @@ study files, the Python API):
 * three finite numbers, not all zero: ``"1 0 0"``, ``"1, 0, 0"``, ``[0, 0.6, 0.8]``, or
   a numpy array of shape (3,).
 
-Anything else is an :class:`~microg.errors.InputError` naming ``where``.  The vector is
-returned normalised; its norm is computed with scaling so that components as large as
-1e308 neither overflow nor warn.
+Anything else is an :class:`~microg.errors.InputError` naming ``where`` (``"+-x"``, ``"x y"``,
+``"1,5 0 0"``, booleans, bytes, text longer than :data:`MAX_TEXT` characters, numbers beyond
+the floating-point range).  The vector is returned normalised; its norm is computed with
+scaling so that components as large as 1e308 neither overflow nor warn.
 """
 
 from __future__ import annotations
@@ -23,7 +24,7 @@ import numpy as np
 
 from microg.errors import InputError
 
-__all__ = ["AXES", "AXIS_NAMES", "DIRECTION_FIX", "axis_name", "parse_direction"]
+__all__ = ["AXES", "AXIS_NAMES", "DIRECTION_FIX", "MAX_TEXT", "axis_name", "parse_direction"]
 
 #: unit vectors of the station axes
 AXES: dict[str, np.ndarray] = {
@@ -34,14 +35,24 @@ AXES: dict[str, np.ndarray] = {
 AXIS_NAMES = ("x", "y", "z")
 #: the accepted forms, for error messages
 DIRECTION_FIX = "write x, y, z, -x, ... or three numbers such as '1 0 0'"
+#: longest direction text accepted, characters
+MAX_TEXT = 200
 
 _AXIS = re.compile(r"^([+-]?)([xyz])$")
-_NUMBER = re.compile(r"^[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?$")
+_NUMBER = re.compile(r"^[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?$")
+
+
+def _fail(text: Any, where: str, why: str = "") -> InputError:
+    shown = " ".join(repr(text).split())
+    shown = shown if len(shown) <= 60 else shown[:57] + "..."
+    return InputError(f"cannot read direction {shown}{why}", where=where, fix=DIRECTION_FIX)
 
 
 def _unit(vec: np.ndarray, text: Any, where: str) -> np.ndarray:
-    if vec.shape != (3,) or not np.all(np.isfinite(vec)) or not np.any(vec):
-        raise InputError(f"cannot read direction {text!r}", where=where, fix=DIRECTION_FIX)
+    if vec.shape != (3,) or not np.all(np.isfinite(vec)):
+        raise _fail(text, where)
+    if not np.any(vec):
+        raise _fail(text, where, ": it is the zero vector")
     scale = float(np.max(np.abs(vec)))
     v = vec / scale  # largest component 1: no overflow in the norm
     return v / math.sqrt(float(v @ v))
@@ -63,28 +74,41 @@ def parse_direction(value: str | Sequence[float] | np.ndarray, where: str) -> np
         The unit vector, station frame.
     """
     if isinstance(value, str):
+        if len(value) > MAX_TEXT:
+            raise _fail(value, where, f": longer than {MAX_TEXT} characters")
         token = value.strip().lower()
         m = _AXIS.match(token.replace(" ", ""))
         if m:
-            return (-1.0 if m.group(1) == "-" else 1.0) * AXES[m.group(2)].copy()
-        parts = [p for p in re.split(r"[\s,;]+", token) if p]
+            axis = np.zeros(3)
+            axis[AXIS_NAMES.index(m.group(2))] = -1.0 if m.group(1) == "-" else 1.0
+            return axis
+        # one kind of separator: "1 0 0", "1, 0, 0" or "1; 0; 0" ("1,5 0" is not 1, 5, 0)
+        sep = "," if "," in token else ";" if ";" in token else None
+        parts = [p.strip() for p in token.split(sep)] if sep else token.split()
         if len(parts) != 3 or not all(_NUMBER.match(p) for p in parts):
-            raise InputError(f"cannot read direction {value!r}", where=where, fix=DIRECTION_FIX)
-        return _unit(np.array([float(p) for p in parts]), value, where)
-    if isinstance(value, bool):
-        raise InputError(f"cannot read direction {value!r}", where=where, fix=DIRECTION_FIX)
+            raise _fail(value, where)
+        vec = np.array([float(p) for p in parts])
+        if not np.all(np.isfinite(vec)):
+            raise _fail(value, where, ": a component is beyond the floating-point range")
+        return _unit(vec, value, where)
+    if isinstance(value, bool | bytes | bytearray | dict) or value is None:
+        raise _fail(value, where)
+    if isinstance(value, np.ndarray) and value.shape != (3,):
+        raise _fail(value, where)
     try:
-        items = list(value)  # type: ignore[arg-type]
+        items = list(value)
     except TypeError:
-        raise InputError(
-            f"cannot read direction {value!r}", where=where, fix=DIRECTION_FIX
-        ) from None
+        raise _fail(value, where) from None
     if len(items) != 3 or any(
-        isinstance(c, bool) or not isinstance(c, int | float | np.integer | np.floating)
+        isinstance(c, bool | np.bool_) or not isinstance(c, int | float | np.integer | np.floating)
         for c in items
     ):
-        raise InputError(f"cannot read direction {value!r}", where=where, fix=DIRECTION_FIX)
-    return _unit(np.array(items, dtype=float), value, where)
+        raise _fail(value, where)
+    try:
+        vec = np.array([float(c) for c in items])
+    except OverflowError:
+        raise _fail(value, where, ": a component is beyond the floating-point range") from None
+    return _unit(vec, value, where)
 
 
 def axis_name(direction: np.ndarray, tol: float = 1e-12) -> str | None:

@@ -191,3 +191,48 @@ def test_amax_general_times(omega: float, t1: float, gap: float, dur: float) -> 
     exact = float(accel_amax(omega, p))
     assert sampled <= exact * (1 + 1e-12)
     assert sampled >= exact * (1 - 2e-6)
+
+
+# ------------------------------------------------------- issue 8: one crew-force type, one rule
+
+
+@pytest.mark.parametrize(
+    ("args", "where"),
+    [
+        ((-25.0, 1.0, 13.0, 14.0), "f0"),  # f0 > 0 everywhere (forces accepted f0 != 0)
+        ((0.0, 1.0, 13.0, 14.0), "f0"),
+        ((1e300, 1.0, 13.0, 14.0), "f0"),  # beyond the 1e7 N limit
+        ((1.0, 0.0, 13.0, 14.0), "t1"),
+        ((1.0, 1e-9, 13.0, 14.0), "t1"),  # shorter than MIN_RAMP_S
+        ((1.0, 2.0, 1.0, 14.0), "t13"),
+        ((1.0, 1.0, 13.0, 13.0), "t14"),
+        ((1.0, 1.0, 13.0, 2e7), "t14"),  # beyond the 1e7 s limit
+        ((True, 1.0, 13.0, 14.0), "f0"),
+    ],
+)
+def test_one_crew_force_type_one_validation(args: tuple, where: str) -> None:
+    from microg.dynamics.forces import activity_library, crew_pushoff
+
+    errors = []
+    for make in (
+        lambda: CrewPushoff(*args),
+        lambda: crew_pushoff(*args),
+        lambda: activity_library()["report-pushoff"].history(
+            **dict(zip(("f0", "t1", "t13", "t14"), args, strict=True))
+        ),
+    ):
+        with pytest.raises(InputError) as exc:
+            make()
+        errors.append((exc.value.where, exc.value.what))
+    assert errors[0][0] == where  # the parameter, not a CLI flag
+    assert errors[0] == errors[1] == errors[2]  # the same rule and the same words
+
+
+def test_crew_pushoff_history_uses_the_type() -> None:
+    from microg.dynamics.forces import crew_pushoff
+
+    p = CrewPushoff(40.0, 0.5, 3.0, 3.5)
+    t, f = p.breakpoints()
+    h = crew_pushoff(40.0, 0.5, 3.0, 3.5)
+    assert np.array_equal(h.timepts, t) and np.array_equal(h.force, f)
+    assert isinstance(p.f0, float) and p.f0 == 40.0

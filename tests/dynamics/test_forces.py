@@ -119,9 +119,9 @@ def test_csv_units_line(tmp_path):
         ("time [s], force [N]\n0, 0\n1, nan\n", 3, "finite"),
         ("time [s], force [N]\n0, 0\n1, abc\n", 3, "not a number"),
         ("time [s]\n0\n1\n", 1, "missing column 'force'"),
-        ("time [s], force [m]\n0, 0\n1, 1\n", 1, "not a force"),
+        ("time [s], force [m]\n0, 0\n1, 1\n", 1, "not a unit of force"),
         ("time [s], force\n0, 0\n1, 1\n", 1, "no unit"),
-        ("time [s], force [N], colour\n0, 0, red\n", 1, "unknown column"),
+        ("time [s], force [N], colour\n0, 0, red\n", 1, "not a known column"),
         ("time [s], force [N]\n0, 0\n1, 1, 3\n", 3, "expected 2 values"),
         ("time [s], force [N], direction\n0, 0, x\n1, 1, y\n", 3, "direction changes"),
     ],
@@ -171,3 +171,174 @@ def test_library_magnitudes_from_domain_notes():
     assert lib["report-pushoff"].f0 == pytest.approx(REPORT_F0_N, rel=1e-15)
     assert parse_force_spec("hand-pushoff-mean:t1=0.3s,t14=10.8s").timepts[1] == 0.3
     assert set(expected) <= set(known_force_specs())
+
+
+# ------------------------------------------------------------- issue 10 and 9: the CSV reader
+
+
+@pytest.mark.parametrize(
+    ("content", "needle"),
+    [
+        ("time [s],force [N]\n0,0\n1,caf\xe9\n".encode("latin-1"), "not UTF-8 text (byte"),
+        ("time [s],force [N]\n0,0\n1,1\n".encode("utf-16"), "UTF-16"),
+        (b"\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR", "binary content"),
+    ],
+)
+def test_csv_latin1_utf16_binary_is_one_line(tmp_path, content, needle):
+    p = tmp_path / "f.csv"
+    p.write_bytes(content)
+    with pytest.raises(InputError) as err:
+        from_csv(p)
+    assert needle in str(err.value) and "\n" not in str(err.value)
+
+
+def test_csv_utf8_bom_is_accepted(tmp_path):
+    p = tmp_path / "f.csv"
+    p.write_bytes(b"\xef\xbb\xbftime [s],force [N]\n0,0\n1,2\n")
+    assert np.array_equal(from_csv(p).force, [0.0, 2.0])
+
+
+def test_csv_10_mb_cell(tmp_path):
+    # was a _csv.Error traceback
+    p = tmp_path / "f.csv"
+    p.write_text("time [s],force [N]\n0,0\n1," + "9" * 10_000_000 + "\n")
+    with pytest.raises(InputError, match="line 3 is longer than 4096 characters"):
+        from_csv(p)
+
+
+def test_proc_self_environ_is_not_echoed(tmp_path, monkeypatch):
+    # `--force /proc/self/environ` printed the first line of the environment
+    monkeypatch.setenv("MICROG_TEST_SECRET", "hunter2-do-not-print")
+    for spec in ("/proc/self/environ",):
+        with pytest.raises(InputError) as err:
+            parse_force_spec(spec)
+        assert "hunter2" not in str(err.value) and "MICROG_TEST_SECRET" not in str(err.value)
+    # a text file of secrets given by mistake: no cell is quoted
+    p = tmp_path / "secrets.csv"
+    p.write_text("API_KEY=hunter2-do-not-print\nTOKEN=abc\n")
+    with pytest.raises(InputError) as err:
+        from_csv(p)
+    assert "hunter2" not in str(err.value) and "not a known column" in str(err.value)
+    p.write_text("time [s],force [hunter2]\n0,0\n1,hunter2\n")
+    with pytest.raises(InputError) as err:
+        from_csv(p)
+    assert "hunter2" not in str(err.value)
+
+
+@pytest.mark.parametrize("value", ["1.7e308", "-1.7e308", "1e400", "inf", "nan", "1_0", "\u0663"])
+def test_csv_non_finite_or_huge_value_names_its_line(tmp_path, value):
+    # +/-1.7e308 ended in a ValueError from arange; "1_0" and Arabic digits are not plain
+    p = tmp_path / "f.csv"
+    p.write_text(f"time [s],force [N]\n0,0\n1,0\n2,{value}\n3,0\n")
+    with pytest.raises(InputError) as err:
+        from_csv(p)
+    assert "line 4" in str(err.value) and "force" in str(err.value)
+
+
+def test_csv_a_million_rows_vectorised_and_bad_row_found(tmp_path):
+    # the 1e6-row reproduction (more than 60 s before); read vectorised (measured: about
+    # 1.5 s for 1e6 rows of two columns, see the report).  Checked against numpy's own parse.
+    n = 1_000_000
+    t = np.arange(n) * 1e-3
+    f = np.round(100 * np.sin(t), 6)
+    body = "\n".join(f"{a:.3f},{b:.6f}" for a, b in zip(t, f, strict=True))
+    p = tmp_path / "big.csv"
+    p.write_text("time [ms],force [kN]\n" + body + "\n")
+    h = from_csv(p)
+    assert h.timepts.size == n
+    np.testing.assert_allclose(h.timepts, np.round(t, 3) * 1e-3, rtol=1e-15, atol=0)
+    np.testing.assert_allclose(h.force, f * 1e3, rtol=1e-15, atol=0)  # kN -> N, exact x1000
+    bad = body.split("\n")
+    bad[765_432] = "765.432,abc"
+    p.write_text("time [ms],force [kN]\n" + "\n".join(bad) + "\n")
+    with pytest.raises(InputError, match="line 765434: force is not a number"):
+        from_csv(p)
+
+
+def test_csv_unit_suffix_after_underscore(tmp_path):
+    # issue 9 sec. 3: time_s,force_N (and time_ms,force_lbf)
+    p = write(tmp_path, "time_s,force_N\n0,0\n1,5\n")
+    assert np.array_equal(from_csv(p).force, [0.0, 5.0])
+    p = write(tmp_path, "time_ms,force_lbf\n0,0\n500,2\n")
+    h = from_csv(p)
+    assert h.timepts[1] == 0.5 and h.force[1] == pytest.approx(2 * LBF, rel=1e-15)
+
+
+def test_csv_three_force_components_give_a_varying_direction(tmp_path):
+    # issue 9 sec. 3: t [s],Fx [N],Fy [N],Fz [N]
+    p = write(tmp_path, "t [s],Fx [N],Fy [N],Fz [N]\n0,0,0,0\n1,3,4,0\n2,0,0,5\n3,0,0,0\n")
+    h = from_csv(p)
+    assert h.is_vector and h.direction is None
+    expected = np.array([[0, 3, 0, 0], [0, 4, 0, 0], [0, 0, 5, 0]], float)
+    assert np.array_equal(h.components(), expected)
+    assert np.array_equal(h.components(np.array([1.0, 0, 0])), expected)  # its own wins
+    assert np.allclose(h.force, [0, 5, 5, 0])  # magnitudes
+    # linear in each component between breakpoints: halfway from (3,4,0) to (0,0,5)
+    np.testing.assert_allclose(h.at(1.5), [1.5, 2.0, 2.5], rtol=0, atol=1e-15)
+    np.testing.assert_allclose(h.at(np.array([-1.0, 9.0])), [[0, 0], [0, 0], [0, 0]])
+    # impulse vector by trapezoids: x 3, y 4, z 5 (N s); its magnitude
+    assert h.impulse() == pytest.approx(np.sqrt(3.0**2 + 4.0**2 + 5.0**2), rel=1e-15)
+
+
+def test_csv_parallel_components_become_scalar_with_direction(tmp_path):
+    p = write(tmp_path, "time [s],fx [lbf],fy [lbf],fz [lbf]\n0,0,0,0\n1,0,-2,0\n2,0,1,0\n")
+    h = from_csv(p)
+    assert not h.is_vector and np.array_equal(h.direction, [0, -1, 0])
+    np.testing.assert_allclose(h.force, [0, 2 * LBF, -LBF], rtol=1e-15)
+    np.testing.assert_allclose(h.components(), [[0, 0, 0], [0, -2 * LBF, LBF], [0, 0, 0]])
+
+
+@pytest.mark.parametrize(
+    ("header", "needle"),
+    [
+        ("time [s],fx [N],fy [N]", "missing column(s) fz"),
+        ("time [s],force [N],fx [N],fy [N],fz [N]", "either force or fx"),
+        ("time [s],fx [N],fy [N],fz [N],direction", "direction column goes with force"),
+    ],
+)
+def test_csv_component_header_errors(tmp_path, header, needle):
+    p = write(tmp_path, header + "\n0,0,0,0,0\n")
+    with pytest.raises(InputError, match=needle.replace("(", r"\(").replace(")", r"\)")):
+        from_csv(p)
+
+
+def test_components_of_a_scalar_force():
+    f = crew_pushoff()
+    with pytest.raises(InputError, match="no direction"):
+        f.components()
+    c = f.components(np.array([0.0, 0.0, 2.0]))
+    assert np.array_equal(c, np.outer([0, 0, 1], f.force))
+    g = f.with_direction(np.array([0.0, 3.0, 4.0]))
+    np.testing.assert_allclose(
+        g.components(np.array([1.0, 0, 0])), np.outer([0, 0.6, 0.8], f.force)
+    )
+
+
+@pytest.mark.parametrize(
+    ("spec", "needle"),
+    [
+        ("crew-pushoff:f0=40lbf,f0=50lbf", "f0 is given twice"),  # kept 50 lbf silently
+        ("crew-pushoff:f0=2**5000 lbf", "only one number"),  # a traceback
+        ("crew-pushoff:f0=9**9**9 lbf", "only one number"),  # a hang
+        ("crew-pushoff:f0=lbf", "has a unit but no number"),  # meant 1 lbf
+        ("crew-pushoff:f0=1e300 lbf", "beyond the physical limit"),  # ValueError in plotting
+        ("crew-pushoff:f0=-5 lbf", "must be > 0"),
+        ("crew-pushoff:f0=40lbf,", "empty parameter"),
+        ("crew-pushoff:t1=1,5 s", "decimal comma"),
+        ("crew-pushoff:g=3 N", "cannot read parameter"),
+        ("crew-pushoff:t14=2e7 s", "beyond the physical limit"),
+        ("a" * 5000, "longer than"),
+        ("x\x00y.csv", "NUL"),
+    ],
+)
+def test_force_spec_errors(spec, needle):
+    with pytest.raises(InputError) as err:
+        parse_force_spec(spec)
+    assert needle in str(err.value) and "\n" not in str(err.value)
+
+
+def test_force_history_limits():
+    with pytest.raises(InputError, match="beyond the limit of 1e\\+07 N"):
+        piecewise_linear([0, 1], [0, 1e300])
+    with pytest.raises(InputError, match="beyond the limit of 1e\\+07 s"):
+        piecewise_linear([0, 1.7e308], [0, 1])

@@ -272,8 +272,9 @@ def claims(mu_max: float, as_json: bool) -> None:
 @isolate.command()
 @click.option(
     "--out",
-    type=click.Path(dir_okay=False, writable=True),
-    required=True,
+    type=click.Path(dir_okay=False),
+    default="figure8.png",
+    show_default=True,
     help="PNG file to write (atomically)",
 )
 @click.option(
@@ -287,11 +288,13 @@ def figure8(out: str, r2_max: float) -> None:
     """Figure 8: M_a against r^2, six panels at zeta = 0.2."""
     from pathlib import Path
 
+    from microg._io import check_writable
     from microg.errors import InputError
     from microg.plotting.isolation import figure8 as make
 
     if Path(out).suffix.lower() != ".png":
         raise InputError(f"{out!r} is not a .png file", where="--out", fix="name it *.png")
+    check_writable(out, "--out", directory=False)  # before drawing
     try:
         make(out, r2_max=r2_max)
     except OSError as exc:

@@ -1,4 +1,8 @@
-"""Click parameter types that parse physical quantities and ranges at the boundary."""
+"""Click parameter types that parse physical quantities and ranges at the boundary.
+
+Quantities follow the grammar of :mod:`microg.units` (one number, one unit) and the
+physical limits of :data:`microg.units.LIMITS`.
+"""
 
 from __future__ import annotations
 
@@ -7,15 +11,17 @@ import math
 import click
 
 from microg.errors import InputError
-from microg.units import parse_quantity
+from microg.units import G0, LIMITS, check_limit, parse_quantity
 
-__all__ = ["QuantityType", "RangeType", "BandType", "PositiveFloat"]
+__all__ = ["QuantityType", "MassOrWeightType", "RangeType", "BandType", "PositiveFloat"]
 
 
 class QuantityType(click.ParamType):
     """A physical quantity: ``"25 lbf"``, ``"111 N"``; a bare number takes ``default_unit``.
 
-    Converts to an SI float.  ``minimum``/``strict`` bound the SI value.
+    Converts to an SI float within the physical limit of its dimension
+    (:data:`microg.units.LIMITS`).  ``minimum``/``strict`` bound the SI value from below,
+    ``maximum`` from above.
     """
 
     name = "quantity"
@@ -27,11 +33,13 @@ class QuantityType(click.ParamType):
         *,
         minimum: float | None = None,
         strict: bool = False,
+        maximum: float | None = None,
     ):
         self.dimension = dimension
         self.default_unit = default_unit
         self.minimum = minimum
         self.strict = strict
+        self.maximum = LIMITS[dimension] if maximum is None else maximum
 
     def get_metavar(self, param: click.Parameter, ctx: click.Context | None = None) -> str:
         return "Q" if self.default_unit is None else f"Q[{self.default_unit}]"
@@ -43,6 +51,7 @@ class QuantityType(click.ParamType):
             si = parse_quantity(
                 value, self.dimension, where="value", default_unit=self.default_unit
             )
+            check_limit(si, self.dimension, where="value")
         except InputError as exc:
             self.fail(f"{exc.what}" + (f" ({exc.fix})" if exc.fix else ""), param, ctx)
         if self.minimum is not None:
@@ -50,7 +59,55 @@ class QuantityType(click.ParamType):
             if bad:
                 op = ">" if self.strict else ">="
                 self.fail(f"must be {op} {self.minimum:g}, got {value!r}", param, ctx)
+        if abs(si) > self.maximum:
+            self.fail(f"must be at most {self.maximum:g} (SI), got {value!r}", param, ctx)
         return si
+
+
+class MassOrWeightType(click.ParamType):
+    """A mass (``"200 kg"``, ``"14 slug"``) or an Earth weight (``"441 lbf"``) -> kg.
+
+    A weight W is turned into the mass W / g0 (standard gravity 9.80665 m/s^2).  A bare
+    number takes ``default_unit`` (a mass or a force unit).  The result is > 0 and within
+    the physical limit on masses.
+    """
+
+    name = "mass"
+
+    def __init__(self, default_unit: str):
+        self.default_unit = default_unit
+
+    def get_metavar(self, param: click.Parameter, ctx: click.Context | None = None) -> str:
+        return f"Q[{self.default_unit}]"
+
+    def convert(self, value, param, ctx):
+        if isinstance(value, float):
+            return value
+        errors = []
+        for dimension, scale in (("mass", 1.0), ("force", 1.0 / G0)):
+            default = self.default_unit
+            try:
+                si = parse_quantity(value, dimension, where="value", default_unit=default)
+            except InputError as exc:
+                errors.append(exc)
+                continue
+            mass = si * scale
+            if not mass > 0:
+                self.fail(f"must be > 0, got {value!r}", param, ctx)
+            try:
+                check_limit(mass, "mass", where="value")
+            except InputError as exc:
+                self.fail(exc.what, param, ctx)
+            return mass
+        first = next((e for e in errors if "is not a" not in e.what), errors[0])
+        what = first.what
+        if "is not a" in what:
+            what = f"{value!r} is neither a mass (kg, slug, lb) nor a weight (N, lbf)"
+        self.fail(
+            what + (f" ({first.fix})" if first.fix and "is not a" not in first.what else ""),
+            param,
+            ctx,
+        )
 
 
 class PositiveFloat(click.ParamType):

@@ -90,20 +90,16 @@ def reproduce(
     OUT/lab-response.png (Eq. 2.20b at z_e) and OUT/results.json; every computed value
     follows the crew-force and point options.
     """
-    from microg._io import dumps, write_output_files
+    from microg._io import check_writable, dumps, write_run_directory
     from microg.dynamics.crew import CrewPushoff
-    from microg.plotting.seed import (
-        figure3,
-        figure4,
-        png_bytes,
-        png_data_uri,
-        point_response_figure,
-    )
+    from microg.plotting.common import png_bytes, png_data_uri
+    from microg.plotting.seed import figure3, figure4, point_response_figure
     from microg.report.html import render_reproduction
     from microg.seed.ioc import FT
     from microg.seed.reproduce import ReproduceOptions
     from microg.seed.reproduce import reproduce as run
 
+    check_writable(out_dir, "--out")  # before computing: a bad --out fails at once
     crew = CrewPushoff.checked(f0, t1, t13, t14)
     rep = run(ReproduceOptions(crew, z_e, z_a))
     if cases:
@@ -129,7 +125,7 @@ def reproduce(
         "report.html": html,
         "results.json": text,
     }
-    path = write_output_files(out_dir, files, where="--out")
+    path = write_run_directory(out_dir, files, where="--out")
     if as_json:
         click.echo(text)
     else:

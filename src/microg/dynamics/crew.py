@@ -29,24 +29,48 @@ from dataclasses import dataclass
 import numpy as np
 
 from microg.errors import InputError
+from microg.units import check_limit
 
-__all__ = ["CrewPushoff", "displacement_u", "acceleration_a", "accel_amax", "force"]
+__all__ = [
+    "CrewPushoff",
+    "MIN_RAMP_S",
+    "displacement_u",
+    "acceleration_a",
+    "accel_amax",
+    "force",
+]
+
+
+#: shortest push-off ramp and landing, s: a shorter pulse is an impulse, and f0 / t1 would
+#: leave the floating-point range in the closed forms
+MIN_RAMP_S = 1e-6
+
+#: the one message for the sign convention of f0
+_F0_FIX = "give the magnitude (e.g. 25 lbf); the direction carries the sign"
 
 
 @dataclass(frozen=True)
 class CrewPushoff:
-    """The crew force of Eq. 2.16.
+    """The crew force of Eq. 2.16: the one crew-force type (validated on construction).
+
+    :func:`microg.dynamics.forces.crew_pushoff` turns it into a
+    :class:`~microg.dynamics.forces.ForceHistory`; the closed forms below take it directly.
 
     Attributes
     ----------
     f0 : float
-        Peak force, N (the report: 25 lbf = 111.2 N).
+        Peak force, N (the report: 25 lbf = 111.2 N); ``0 < f0 <= LIMITS["force"]`` (1e7 N).
     t1 : float
-        Push-off ramp duration, s (1 s).
+        Push-off ramp duration, s (1 s); at least :data:`MIN_RAMP_S`.
     t13 : float
-        Landing start, s (13 s).
+        Landing start, s (13 s); ``t13 >= t1``.
     t14 : float
-        Landing end, s (14 s).
+        Landing end, s (14 s); ``t14 - t13 >= MIN_RAMP_S`` and ``t14 <= LIMITS["time"]`` (1e7 s).
+
+    Raises
+    ------
+    InputError
+        Naming the parameter (``f0``, ``t1``, ``t13``, ``t14``) that breaks a rule.
     """
 
     f0: float
@@ -54,24 +78,43 @@ class CrewPushoff:
     t13: float = 13.0
     t14: float = 14.0
 
+    def __post_init__(self) -> None:
+        vals = {"f0": self.f0, "t1": self.t1, "t13": self.t13, "t14": self.t14}
+        for name, v in vals.items():
+            if isinstance(v, bool) or not isinstance(v, int | float | np.integer | np.floating):
+                raise InputError(f"must be a number, got {v!r}", where=name)
+            if not np.isfinite(v):
+                raise InputError(f"must be finite, got {v}", where=name)
+            object.__setattr__(self, name, float(v))
+        f0, t1, t13, t14 = self.f0, self.t1, self.t13, self.t14
+        if not f0 > 0:
+            raise InputError(f"must be > 0, got {f0:g} N", where="f0", fix=_F0_FIX)
+        check_limit(f0, "force", where="f0")
+        if not t1 >= MIN_RAMP_S:
+            raise InputError(f"must be >= {MIN_RAMP_S:g} s, got {t1:g} s", where="t1")
+        if not t13 >= t1:
+            raise InputError(f"must be >= t1 ({t1:g} s), got {t13:g} s", where="t13")
+        if not t14 - t13 >= MIN_RAMP_S:
+            raise InputError(
+                f"must be > t13 ({t13:g} s) by at least {MIN_RAMP_S:g} s, got {t14:g} s",
+                where="t14",
+            )
+        check_limit(t14, "time", where="t14")
+
     @classmethod
     def checked(cls, f0: float, t1: float, t13: float, t14: float) -> CrewPushoff:
-        """Validate ``0 < t1 <= t13 < t14`` and a finite non-zero ``f0``."""
-        vals = {"f0": f0, "t1": t1, "t13": t13, "t14": t14}
-        for name, v in vals.items():
-            if not np.isfinite(v):
-                raise InputError(f"must be finite, got {v}", where=f"--{name}")
-        if not f0 > 0:
+        """The CLI's constructor: as ``CrewPushoff(...)``, with errors naming ``--f0``, ...
+
+        The validation is the constructor's (one rule); only the names differ, until the
+        CLI maps parameter names to its flags itself.
+        """
+        try:
+            return cls(f0, t1, t13, t14)
+        except InputError as exc:
+            where = f"--{exc.where}" if exc.where in ("f0", "t1", "t13", "t14") else exc.where
             raise InputError(
-                f"must be > 0, got {f0:g} N", where="--f0", fix="the direction carries the sign"
-            )
-        if not t1 > 0:
-            raise InputError(f"must be > 0 s, got {t1:g}", where="--t1")
-        if not t13 >= t1:
-            raise InputError(f"must be >= --t1 ({t1:g} s), got {t13:g}", where="--t13")
-        if not t14 > t13:
-            raise InputError(f"must be > --t13 ({t13:g} s), got {t14:g}", where="--t14")
-        return cls(float(f0), float(t1), float(t13), float(t14))
+                exc.what.replace(" t1 (", " --t1 ("), where=where, fix=exc.fix
+            ) from None
 
     @property
     def impulse_pushoff(self) -> float:

@@ -8,14 +8,17 @@ A :class:`ForceHistory` is a piecewise-linear function of time given by breakpoi
   the last value holds from that time on (right-continuous);
 * after the last breakpoint the force holds its last value.
 
+A history is either a scalar force along a direction (its own, or the one it is applied in),
+or a vector force whose three components are given at each breakpoint (``vector``, a direction
+that varies in time).  :meth:`ForceHistory.components` gives both as a (3, nb) array in N.
+
 Everything inside is SI (s, N).  Units are parsed here, at the boundary, with
-:func:`microg.units.parse_quantity`.
+:mod:`microg.units`; magnitudes are bounded by :data:`microg.units.LIMITS`.
 """
 
 from __future__ import annotations
 
 import csv
-import math
 import re
 import tomllib
 from dataclasses import dataclass, field
@@ -28,12 +31,14 @@ import numpy as np
 from microg._vectors import parse_direction
 from microg.dynamics.crew import CrewPushoff
 from microg.errors import InputError
-from microg.units import LBF, parse_quantity
+from microg.units import LBF, LIMITS, parse_quantity, parse_unit
 
 __all__ = [
     "ForceHistory",
     "Activity",
     "REPORT_F0_N",
+    "MAX_CSV_BYTES",
+    "MAX_CSV_LINE",
     "crew_pushoff",
     "piecewise_linear",
     "from_csv",
@@ -44,6 +49,12 @@ __all__ = [
 
 #: the report's push-off magnitude, 25 lbf in newtons (1 lbf = 4.4482216152605 N exactly)
 REPORT_F0_N = 25.0 * LBF
+#: largest force file read, bytes (a million rows of three forces is about 40 MB)
+MAX_CSV_BYTES = 256 * 2**20
+#: longest line of a force file, characters
+MAX_CSV_LINE = 4096
+#: longest force spec on the command line, characters
+MAX_SPEC = 4096
 
 
 def _readonly(a: np.ndarray) -> np.ndarray:
@@ -52,84 +63,170 @@ def _readonly(a: np.ndarray) -> np.ndarray:
     return a
 
 
+def _first(mask: np.ndarray) -> int:
+    return int(np.flatnonzero(mask)[0])
+
+
+def _check_magnitudes(t: np.ndarray, f: np.ndarray, where: str) -> None:
+    """Finite, and within the physical limits on times and forces (s, N)."""
+    if not np.all(np.isfinite(t)):
+        raise InputError(f"time[{_first(~np.isfinite(t))}] is not a finite number", where=where)
+    if not np.all(np.isfinite(f)):
+        bad = ~np.isfinite(f).reshape(-1, t.size).all(axis=0)
+        raise InputError(f"force[{_first(bad)}] is not a finite number", where=where)
+    if np.any(np.abs(t) > LIMITS["time"]):
+        i = _first(np.abs(t) > LIMITS["time"])
+        raise InputError(
+            f"time[{i}] = {t[i]:.6g} s is beyond the limit of {LIMITS['time']:g} s", where=where
+        )
+    big = (np.abs(f) > LIMITS["force"]).reshape(-1, t.size).any(axis=0)
+    if np.any(big):
+        raise InputError(
+            f"force[{_first(big)}] is beyond the limit of {LIMITS['force']:g} N", where=where
+        )
+
+
 @dataclass(frozen=True, eq=False)
 class ForceHistory:
-    """A piecewise-linear force history f(t) applied along an optional fixed direction.
+    """A piecewise-linear force history f(t), scalar along a direction or a 3-D vector.
 
     Attributes
     ----------
     timepts : (nb,) breakpoint times, s, non-decreasing; a repeated time is a jump
-    force : (nb,) force at each breakpoint, N
+    force : (nb,) force at each breakpoint, N: the signed force along the direction, or, for a
+        vector history, the magnitude of the force vector at each breakpoint
     name : label for output
-    direction : optional (3,) unit vector of the force in the model frame
+    direction : optional (3,) unit vector of a scalar force in the model frame (its own
+        direction, which wins over the direction it is applied in)
+    vector : optional (3, nb) force vector at each breakpoint, N, model frame (a direction
+        that varies in time); give ``force=None`` with it
+
+    Limits: times within +/- ``LIMITS["time"]`` (1e7 s), each force component within
+    +/- ``LIMITS["force"]`` (1e7 N), all finite.
     """
 
     timepts: np.ndarray
-    force: np.ndarray
+    force: np.ndarray | None
     name: str = "force"
     direction: np.ndarray | None = field(default=None)
+    vector: np.ndarray | None = field(default=None)
 
     def __post_init__(self) -> None:
-        t = _readonly(self.timepts)
-        f = _readonly(self.force)
         where = f"force {self.name!r}"
-        if t.ndim != 1 or f.shape != t.shape or t.size < 1:
-            raise InputError(
-                "timepts and force must be 1-D arrays of equal length >= 1", where=where
-            )
-        if not (np.all(np.isfinite(t)) and np.all(np.isfinite(f))):
-            raise InputError("times and forces must be finite numbers", where=where)
+        t = _readonly(self.timepts)
+        if t.ndim != 1 or t.size < 1:
+            raise InputError("timepts must be a 1-D array of length >= 1", where=where)
+        if self.vector is not None:
+            if self.force is not None or self.direction is not None:
+                raise InputError("give either force (and direction) or vector", where=where)
+            v = _readonly(self.vector)
+            if v.shape != (3, t.size):
+                raise InputError(f"vector must have shape (3, {t.size})", where=where)
+            _check_magnitudes(t, v, where)
+            object.__setattr__(self, "vector", v)
+            object.__setattr__(self, "force", _readonly(np.sqrt(np.sum(v * v, axis=0))))
+        else:
+            if self.force is None:
+                raise InputError("give force (N) or vector (3, nb)", where=where)
+            f = _readonly(self.force)
+            if f.shape != t.shape:
+                raise InputError(
+                    "timepts and force must be 1-D arrays of equal length >= 1", where=where
+                )
+            _check_magnitudes(t, f, where)
+            object.__setattr__(self, "force", f)
         if np.any(np.diff(t) < 0):
-            i = int(np.flatnonzero(np.diff(t) < 0)[0]) + 1
+            i = _first(np.diff(t) < 0) + 1
             raise InputError(
                 f"breakpoint times must not decrease (time[{i}] = {t[i]} < {t[i - 1]})",
                 where=where,
             )
         object.__setattr__(self, "timepts", t)
-        object.__setattr__(self, "force", f)
         if self.direction is not None:
-            d = np.asarray(self.direction, dtype=float)
-            norm = float(np.linalg.norm(d)) if d.shape == (3,) else 0.0
-            if not (np.isfinite(norm) and norm > 0):
-                raise InputError("direction must be a non-zero 3-vector", where=where)
-            object.__setattr__(self, "direction", _readonly(d / norm))
+            d = parse_direction(np.asarray(self.direction, dtype=float), f"{where}: direction")
+            object.__setattr__(self, "direction", _readonly(d))
+
+    @property
+    def is_vector(self) -> bool:
+        """True when the direction varies in time (the history carries ``vector``)."""
+        return self.vector is not None
 
     @property
     def duration(self) -> float:
         """Time from the first to the last breakpoint, s."""
         return float(self.timepts[-1] - self.timepts[0])
 
+    def components(self, direction: np.ndarray | None = None) -> np.ndarray:
+        """The force vector at each breakpoint, (3, nb), N, model frame.
+
+        A vector history returns its ``vector``; a scalar history ``direction x force``, with
+        its own direction if it has one (it wins), else ``direction``.  Between breakpoints
+        each component is linear, so this is what a response computes from, component by
+        component.
+
+        Parameters
+        ----------
+        direction : (3,) direction of a scalar force without its own (dimensionless)
+        """
+        if self.vector is not None:
+            return self.vector
+        d = self.direction
+        if d is None:
+            if direction is None:
+                raise InputError(
+                    "the force has no direction of its own; give one", where="direction"
+                )
+            d = parse_direction(np.asarray(direction, dtype=float), "direction")
+        assert self.force is not None
+        out = np.outer(d, self.force)
+        out.setflags(write=False)
+        return out
+
     def at(self, t: np.ndarray | float) -> np.ndarray:
         """Force at times ``t`` (s), N: linear between breakpoints, right-continuous at jumps.
 
-        Zero before the first breakpoint; the last value after the last breakpoint.
+        Zero before the first breakpoint; the last value after the last breakpoint.  For a
+        vector history: (3, ...) components.
         """
         t = np.asarray(t, dtype=float)
-        tp, fp = self.timepts, self.force
+        raw = self.vector if self.vector is not None else self.force
+        assert raw is not None
+        values = np.atleast_2d(raw)  # (k, nb): k = 3 components or 1
+        k = values.shape[0]
+        tp = self.timepts
         i = np.searchsorted(tp, t, side="right") - 1
         last = tp.size - 1
-        i_c = np.clip(i, 0, max(last - 1, 0))
+        hold = values[:, -1].reshape(k, *([1] * t.ndim))
         if last == 0:
-            value = np.full(t.shape, fp[0])
+            value = np.broadcast_to(hold, (k, *t.shape))
         else:
+            i_c = np.clip(i, 0, last - 1)
             t0, t1 = tp[i_c], tp[i_c + 1]
             with np.errstate(divide="ignore", invalid="ignore"):
                 frac = np.where(t1 > t0, (t - t0) / (t1 - t0), 1.0)
-            value = fp[i_c] + (fp[i_c + 1] - fp[i_c]) * frac
-        value = np.where(i >= last, fp[-1], value)
-        return np.where(i < 0, 0.0, value)
+            value = values[:, i_c] + (values[:, i_c + 1] - values[:, i_c]) * frac
+            value = np.where(i >= last, hold, value)
+        value = np.where(i < 0, 0.0, value)
+        return value if self.vector is not None else value[0]
 
     def impulse(self) -> float:
         """Integral of the force from the first to the last breakpoint, N*s (trapezoids, exact).
 
-        A force that does not end at zero keeps acting after the last breakpoint; that part is
-        not included.
+        Signed along the direction for a scalar force; the magnitude of the impulse vector for
+        a vector history.  A force that does not end at zero keeps acting after the last
+        breakpoint; that part is not included.
         """
         dt = np.diff(self.timepts)
+        if self.vector is not None:
+            v = self.vector
+            return float(np.linalg.norm(np.sum(0.5 * (v[:, 1:] + v[:, :-1]) * dt, axis=1)))
+        assert self.force is not None
         return float(np.sum(0.5 * (self.force[1:] + self.force[:-1]) * dt))
 
     def with_direction(self, direction: np.ndarray) -> ForceHistory:
-        """A copy applied along ``direction`` (normalised)."""
+        """A copy of a scalar history applied along ``direction`` (normalised)."""
+        if self.vector is not None:
+            raise InputError("a vector force has its own direction at every time", where=self.name)
         return ForceHistory(self.timepts, self.force, self.name, np.asarray(direction, float))
 
     @classmethod
@@ -143,6 +240,38 @@ class ForceHistory:
         """Validated constructor from breakpoint times (s) and forces (N); see the class doc."""
         return cls(np.asarray(timepts, float), np.asarray(force, float), name, direction)
 
+    @classmethod
+    def from_vectors(
+        cls, timepts: np.ndarray, vector: np.ndarray, name: str = "force"
+    ) -> ForceHistory:
+        """A history from breakpoint times (s) and force vectors (3, nb), N.
+
+        When every non-zero vector is parallel to one direction the result is the scalar form
+        (signed force along that direction), which is exact and cheaper downstream.
+        """
+        t = np.asarray(timepts, float)
+        v = np.asarray(vector, float)
+        scalar = _as_scalar(v)
+        if scalar is not None:
+            d, f = scalar
+            return cls(t, f, name, d)
+        return cls(t, None, name, vector=v)
+
+
+def _as_scalar(v: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """(direction, signed force) when the columns of ``v`` (3, nb) are all parallel, else None."""
+    if v.ndim != 2 or v.shape[0] != 3 or not np.all(np.isfinite(v)):
+        return None
+    mags = np.sqrt(np.sum(v * v, axis=0))
+    if not np.any(mags > 0):
+        return None
+    k = int(np.argmax(mags))
+    d = v[:, k] / mags[k]
+    f = d @ v
+    if np.max(np.abs(v - np.outer(d, f))) > 1e-12 * mags[k]:
+        return None
+    return d, f
+
 
 def crew_pushoff(
     f0: float = REPORT_F0_N,
@@ -152,7 +281,7 @@ def crew_pushoff(
     *,
     name: str = "crew-pushoff",
 ) -> ForceHistory:
-    """The report's crew push-off and landing force (Eq. 2.16).
+    """The report's crew push-off and landing force (Eq. 2.16) as a force history.
 
     A ramp from 0 to ``f0`` over (0, t1], then zero until ``t13``; at ``t13`` the force jumps to
     ``-f0`` and ramps back to zero at ``t14``; zero afterwards.  With the report's values
@@ -160,25 +289,16 @@ def crew_pushoff(
     zero.  When ``t14 - t13 != t1`` the landing still peaks at ``-f0`` (as the project reading of
     Eq. 2.16 states) and the net impulse is ``f0 (t1 - (t14 - t13)) / 2``.
 
+    Validation is :class:`~microg.dynamics.crew.CrewPushoff`'s (the one crew-force type).
+
     Parameters
     ----------
-    f0 : peak push-off force, N (report: 25 lbf = 111.2 N); non-zero
+    f0 : peak push-off force, N (report: 25 lbf = 111.2 N); > 0, the direction carries the sign
     t1 : end of the push-off ramp, s (report: 1 s)
     t13 : start of the landing, s (report: 13 s)
     t14 : end of the landing, s (report: 14 s); requires 0 < t1 <= t13 < t14
     name : label
     """
-    values = {"f0": f0, "t1": t1, "t13": t13, "t14": t14}
-    for key, val in values.items():
-        if not math.isfinite(val):
-            raise InputError(f"{key} must be a finite number, got {val}", where=name)
-    if f0 == 0:
-        raise InputError("f0 must be non-zero", where=name, fix="give e.g. f0=25lbf")
-    if not (0 < t1 <= t13 < t14):
-        raise InputError(
-            f"times must satisfy 0 < t1 <= t13 < t14, got t1={t1}, t13={t13}, t14={t14} s",
-            where=name,
-        )
     t, f = CrewPushoff(f0, t1, t13, t14).breakpoints()  # Eq. 2.16, one implementation
     return ForceHistory(t, f, name)
 
@@ -196,28 +316,165 @@ def piecewise_linear(
 
 # ---------------------------------------------------------------------------------------- CSV
 
-_UNIT_IN_HEADER = re.compile(r"^\s*([A-Za-z_]+)\s*(?:\[(.*)\]|\((.*)\))?\s*$")
+#: header names of the columns (lower case) -> column key
+_COLUMN_NAMES = {
+    "time": "time",
+    "t": "time",
+    "force": "force",
+    "f": "force",
+    "fx": "fx",
+    "fy": "fy",
+    "fz": "fz",
+    "direction": "direction",
+    "dir": "direction",
+}
+_COLUMNS_FIX = (
+    "columns are time and force (and optionally direction), or time, fx, fy, fz; units in "
+    "brackets or after an underscore, e.g. 'time [s], force [N]' or 'time_s,force_N'"
+)
+_HEADER_CELL = re.compile(
+    r"^(?P<key>[A-Za-z]+)\s*(?:\[(?P<u1>[^\]]*)\]|\((?P<u2>[^)]*)\)|_(?P<u3>\S.*))?$"
+)
+_BLANK_LINE = re.compile(r"(?:^|\n)[ \t\r]*(?:\n|$)")
+_NUMBER_CHARS = str.maketrans("", "", "0123456789eE+-. \t")
+_STRICT_NUMBER = re.compile(r"^\s*[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?\s*$")
 
 
-def _unit_scale(unit: str, dimension: str, where: str) -> float:
-    unit = unit.strip()
+def _decode(data: bytes, where: str) -> str:
+    """UTF-8 text of a force file (a BOM is dropped); any other content is a one-line error.
+
+    The message names the problem and a byte offset, never the content (a file given by
+    mistake may hold secrets, e.g. /proc/self/environ).
+    """
+    for bom, enc in ((b"\xff\xfe\x00\x00", "UTF-32"), (b"\x00\x00\xfe\xff", "UTF-32"),
+                     (b"\xff\xfe", "UTF-16"), (b"\xfe\xff", "UTF-16")):  # fmt: skip
+        if data.startswith(bom):
+            raise InputError(f"the file is {enc} text", where=where, fix="save it as UTF-8 CSV")
+    nul = data.find(b"\x00")
+    if nul >= 0:
+        raise InputError(
+            f"binary content (a NUL byte at offset {nul}), not a CSV text file",
+            where=where,
+            fix="give a CSV file with a header such as 'time [s], force [N]'",
+        )
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise InputError(
+            f"not UTF-8 text (byte {exc.start})",
+            where=where,
+            fix="save it as UTF-8 (e.g. from latin-1: iconv -f latin1 -t utf-8)",
+        ) from None
+
+
+def _read_text(path: Path, where: str) -> str:
+    try:
+        if not path.is_file():
+            raise InputError("is not a regular file", where=where, fix="give a CSV file")
+        with path.open("rb") as fh:
+            data = fh.read(MAX_CSV_BYTES + 1)
+    except OSError as exc:
+        raise InputError(f"cannot read force file: {exc.strerror or exc}", where=where) from None
+    if len(data) > MAX_CSV_BYTES:
+        raise InputError(
+            f"the file is larger than {MAX_CSV_BYTES // 2**20} MB", where=where, fix="thin it out"
+        )
+    return _decode(data, where)
+
+
+def _split(line: str, lineno: int, where: str) -> list[str]:
+    """Cells of one CSV line (quotes allowed); a csv error is one line naming the line."""
+    try:
+        return next(csv.reader([line]), [])
+    except csv.Error:
+        raise InputError("malformed CSV (quotes)", where=f"{where}, line {lineno}") from None
+
+
+def _header(cells: list[str], where: str) -> tuple[dict[str, int], dict[str, str]]:
+    """Column index and unit text by key, from the header's cells."""
+    columns: dict[str, int] = {}
+    units: dict[str, str] = {}
+    for i, cell in enumerate(cells):
+        m = _HEADER_CELL.match(cell.strip())
+        key = _COLUMN_NAMES.get(m.group("key").lower()) if m else None
+        if m is None or key is None:
+            raise InputError(
+                f"column {i + 1} of the header is not a known column", where=where, fix=_COLUMNS_FIX
+            )
+        if key in columns:
+            raise InputError(f"column {key!r} appears twice", where=where)
+        columns[key] = i
+        units[key] = (m.group("u1") or m.group("u2") or m.group("u3") or "").strip()
+    comps = [k for k in ("fx", "fy", "fz") if k in columns]
+    if "time" not in columns:
+        raise InputError(
+            "missing column 'time'",
+            where=where,
+            fix="the header must name 'time [s]' and 'force [N]' (units of your choice)",
+        )
+    if comps and "force" in columns:
+        raise InputError("give either force or fx, fy, fz, not both", where=where)
+    if comps and len(comps) != 3:
+        missing = ", ".join(k for k in ("fx", "fy", "fz") if k not in columns)
+        raise InputError(f"missing column(s) {missing}", where=where, fix=_COLUMNS_FIX)
+    if comps and "direction" in columns:
+        raise InputError("a direction column goes with force, not with fx, fy, fz", where=where)
+    if not comps and "force" not in columns:
+        raise InputError(
+            "missing column 'force'",
+            where=where,
+            fix="the header must name 'time [s]' and 'force [N]' (units of your choice)",
+        )
+    return columns, units
+
+
+def _scale(unit: str, dimension: str, key: str, where: str) -> float:
+    """SI factor of a header unit; the message names the column, not the file's text."""
     if not unit:
         raise InputError(
-            f"no unit for the {dimension} column",
+            f"no unit for the {key} column",
             where=where,
-            fix="write the unit in the header, e.g. 'time [s], force [lbf]'",
+            fix="write the unit in the header, e.g. 'time [s], force [lbf]' or 'time_s,force_N'",
         )
-    return parse_quantity(f"1 {unit}", dimension, where=where)
+    try:
+        return parse_unit(unit, dimension, where=where)
+    except InputError:
+        raise InputError(
+            f"the unit of the {key} column is not a unit of {dimension}",
+            where=where,
+            fix=f"use e.g. {'s, ms, min' if dimension == 'time' else 'N, kN, lbf'}",
+        ) from None
+
+
+def _column(cells: list[str], key: str, linenos: np.ndarray, where: str) -> np.ndarray:
+    """The floats of one column; the first bad cell is reported by its line, not its text."""
+    bad: int | None = None
+    if "".join(cells).translate(_NUMBER_CHARS):  # a character no plain number has
+        bad = next(i for i, c in enumerate(cells) if not _STRICT_NUMBER.match(c))
+    else:
+        try:
+            return np.array(cells, dtype=float)
+        except ValueError:
+            bad = next(i for i, c in enumerate(cells) if not _STRICT_NUMBER.match(c))
+    cell = cells[bad].strip()
+    what = "is empty" if not cell else "is not a number"
+    if cell.lower().lstrip("+-") in ("nan", "inf", "infinity"):
+        what = "is not a finite number"
+    raise InputError(f"{key} {what}", where=f"{where}, line {linenos[bad]}")
 
 
 def from_csv(path: str | Path, *, name: str | None = None) -> ForceHistory:
     """Read a force history from a CSV file (see docs/assessment.md, "Force files").
 
-    Format: ``#`` starts a comment line; the first other line is the header, naming the columns
-    ``time`` and ``force`` (and optionally ``direction``) with units in brackets, e.g.
-    ``time [s], force [lbf]``; or a header without units followed by a units line (``s, lbf``).
-    Times must increase strictly; values must be finite; ``direction`` (``x``, ``-z``, ``1 0 0``)
-    must be the same on every row where it is given.
+    Format: UTF-8 text; ``#`` starts a comment line; the first other line is the header.  It
+    names the columns ``time`` and ``force`` (and optionally ``direction``), or ``time``,
+    ``fx``, ``fy``, ``fz`` (a force whose direction varies), with units in brackets
+    (``time [s], force [lbf]``), in parentheses, or after an underscore (``time_s,force_N``);
+    or a header without units followed by a units line (``s, lbf``).  Times must increase
+    strictly; values must be plain finite numbers within the limits of
+    :data:`microg.units.LIMITS` (1e7 s, 1e7 N); ``direction`` (``x``, ``-z``, ``1 0 0``) must be
+    the same on every row where it is given.  Rows are read vectorised (a million rows in
+    about a second).
 
     Parameters
     ----------
@@ -227,101 +484,139 @@ def from_csv(path: str | Path, *, name: str | None = None) -> ForceHistory:
     Raises
     ------
     InputError
-        Naming the file and line for a missing column, a unit that is not a force/time, a value
-        that is not a finite number, or a time that does not increase.
+        One line naming the file and line: not UTF-8 text, binary, too large, a missing or
+        unknown column, a unit that is not a force/time, a value that is not a finite number
+        or is beyond the limits, a time that does not increase.  Messages never quote the
+        file's content.
     """
     path = Path(path)
+    where = str(path)
     label = name or path.name
-    try:
-        text = path.read_text(encoding="utf-8-sig")
-    except OSError as exc:
-        raise InputError(f"cannot read force file: {exc.strerror}", where=str(path)) from None
-    rows: list[tuple[int, list[str]]] = []
-    for lineno, line in enumerate(text.splitlines(), start=1):
-        if not line.strip() or line.lstrip().startswith("#"):
-            continue
-        rows.append((lineno, next(csv.reader([line]))))
-    if not rows:
-        raise InputError("empty force file", where=str(path), fix="write 'time [s], force [N]'")
-
-    header_line, header = rows[0]
-    where_h = f"{path}, line {header_line}"
-    columns: dict[str, int] = {}
-    units: dict[str, str] = {}
-    for i, cell in enumerate(header):
-        m = _UNIT_IN_HEADER.match(cell)
-        key = m.group(1).lower() if m else cell.strip().lower()
-        key = {"t": "time", "f": "force", "dir": "direction"}.get(key, key)
-        if key not in ("time", "force", "direction"):
-            raise InputError(
-                f"unknown column {cell.strip()!r}",
-                where=where_h,
-                fix="columns are time, force and optionally direction",
-            )
-        if key in columns:
-            raise InputError(f"column {key!r} appears twice", where=where_h)
-        columns[key] = i
-        unit = (m.group(2) or m.group(3) or "") if m else ""
-        units[key] = unit
-    for key in ("time", "force"):
-        if key not in columns:
-            raise InputError(
-                f"missing column {key!r}",
-                where=where_h,
-                fix="the header must name 'time [s]' and 'force [N]' (units of your choice)",
-            )
-    data = rows[1:]
-    # a units line: first cell of the next line is not a number
-    if data and not units["time"] and not units["force"]:
-        lineno, cells = data[0]
-        try:
-            float(cells[columns["time"]])
-        except (ValueError, IndexError):
+    text = _read_text(path, where)
+    lines = text.replace("\r\n", "\n").split("\n")
+    if max(map(len, lines)) > MAX_CSV_LINE:
+        longest = next(i for i, line in enumerate(lines) if len(line) > MAX_CSV_LINE)
+        raise InputError(
+            f"line {longest + 1} is longer than {MAX_CSV_LINE} characters", where=where
+        )
+    while lines and not lines[-1].strip():
+        lines.pop()
+    meaningful = (
+        i for i, line in enumerate(lines) if line.strip() and not line.lstrip().startswith("#")
+    )
+    header_at = next(meaningful, None)
+    if header_at is None:
+        raise InputError("empty force file", where=where, fix="write 'time [s], force [N]'")
+    where_h = f"{where}, line {header_at + 1}"
+    columns, units = _header(_split(lines[header_at], header_at + 1, where), where_h)
+    ncol = len(columns)
+    data_start = header_at + 1
+    # a units line: a header without units, then a line whose first cell is not a number
+    second = next(meaningful, None)
+    if second is not None and not any(units.values()):
+        cells = _split(lines[second], second + 1, where)
+        first = cells[columns["time"]] if columns["time"] < len(cells) else ""
+        if not _STRICT_NUMBER.match(first):
             for key, i in columns.items():
-                units[key] = cells[i] if i < len(cells) else ""
-            data = data[1:]
-            where_h = f"{path}, line {lineno}"
-    t_scale = _unit_scale(units["time"], "time", f"{where_h}: time")
-    f_scale = _unit_scale(units["force"], "force", f"{where_h}: force")
-    if len(data) < 2:
-        raise InputError("need at least two rows of data", where=str(path))
+                units[key] = cells[i].strip() if i < len(cells) else ""
+            where_h = f"{where}, line {second + 1}"
+            data_start = second + 1
+    t_scale = _scale(units["time"], "time", "time", where_h)
+    fkeys = ["fx", "fy", "fz"] if "fx" in columns else ["force"]
+    f_scales = [_scale(units[k], "force", k, where_h) for k in fkeys]
 
-    ncol = len(header)
-    times = np.empty(len(data))
-    forces = np.empty(len(data))
-    direction: np.ndarray | None = None
-    for r, (lineno, cells) in enumerate(data):
-        where = f"{path}, line {lineno}"
-        if len(cells) != ncol and not (len(cells) == ncol - 1 and "direction" in columns):
-            raise InputError(f"expected {ncol} values, found {len(cells)}", where=where)
-        for key, store in (("time", times), ("force", forces)):
-            cell = cells[columns[key]].strip()
-            try:
-                value = float(cell)
-            except ValueError:
-                raise InputError(f"{key} {cell!r} is not a number", where=where) from None
-            if not math.isfinite(value):
-                raise InputError(f"{key} is {cell!r}; a finite number is required", where=where)
-            store[r] = value
-        if r and times[r] <= times[r - 1]:
+    rows = lines[data_start:]
+    body = "\n".join(rows)
+    linenos = np.arange(data_start + 1, data_start + 1 + len(rows))
+    if "#" in body or _BLANK_LINE.search(body):  # comments or blank lines between the rows
+        keep = [i for i, r in enumerate(rows) if r.strip() and not r.lstrip().startswith("#")]
+        rows = [rows[i] for i in keep]
+        linenos = linenos[keep]
+        body = "\n".join(rows)
+    if len(rows) < 2:
+        raise InputError("need at least two rows of data", where=where)
+    has_dir = "direction" in columns
+    flat = None if '"' in body else body.replace("\n", ",").split(",")
+    if flat is not None and len(flat) == len(rows) * ncol:
+        grid = np.array(flat, dtype=object).reshape(len(rows), ncol)
+
+        def col(key: str) -> list[str]:
+            return grid[:, columns[key]].tolist()
+
+    else:  # quotes, or rows of different lengths: cell by cell
+        table = [_split(r, int(n), where) for r, n in zip(rows, linenos, strict=True)]
+        counts = np.fromiter((len(c) for c in table), dtype=int, count=len(table))
+        ok = (counts == ncol) | (
+            (counts == ncol - 1) & has_dir & (columns.get("direction") == ncol - 1)
+        )
+        if not np.all(ok):
+            r = _first(~ok)
             raise InputError(
-                f"time {times[r]:g} does not increase (previous row: {times[r - 1]:g})",
-                where=where,
-                fix="times must increase strictly from row to row",
+                f"expected {ncol} values, found {counts[r]}", where=f"{where}, line {linenos[r]}"
             )
-        if "direction" in columns and columns["direction"] < len(cells):
-            cell = cells[columns["direction"]].strip()
-            if cell:
-                vec = parse_direction(cell, f"{where}: direction")
-                if direction is None:
-                    direction = vec
-                elif not np.allclose(vec, direction, rtol=0, atol=1e-12):
+
+        def col(key: str) -> list[str]:
+            i = columns[key]
+            return [c[i] if i < len(c) else "" for c in table]
+
+    times = _column(col("time"), "time", linenos, where) * t_scale
+    values = np.array(
+        [_column(col(k), k, linenos, where) * s for k, s in zip(fkeys, f_scales, strict=True)]
+    )
+    for arr, key, limit, unit in (
+        (times[None, :], "time", LIMITS["time"], "s"),
+        (values, "force", LIMITS["force"], "N"),
+    ):
+        bad = np.asarray(~(np.abs(arr) <= limit).all(axis=0))  # also catches inf after scaling
+        if np.any(bad):
+            r = _first(bad)
+            raise InputError(
+                f"{key} is beyond the limit of {limit:g} {unit} (or not finite after its unit)",
+                where=f"{where}, line {linenos[r]}",
+            )
+    step = np.diff(times)
+    if np.any(step <= 0):
+        r = _first(step <= 0) + 1
+        raise InputError(
+            f"time {times[r]:g} s does not increase (previous row: {times[r - 1]:g} s)",
+            where=f"{where}, line {linenos[r]}",
+            fix="times must increase strictly from row to row",
+        )
+    if len(fkeys) == 3:
+        return ForceHistory.from_vectors(times, values, label)
+
+    direction: np.ndarray | None = None
+    if has_dir:
+        cells = [c.strip().lower() for c in col("direction")]
+        seen: dict[str, np.ndarray] = {}
+        for r, cell in enumerate(cells):
+            if not cell or cell in seen:
+                if (
+                    cell
+                    and direction is not None
+                    and not np.allclose(seen[cell], direction, rtol=0, atol=1e-12)
+                ):
                     raise InputError(
-                        "direction changes; a time-varying direction is not supported",
-                        where=where,
-                        fix="use one file per direction",
+                        "direction changes; use fx, fy, fz columns for a direction that varies",
+                        where=f"{where}, line {linenos[r]}",
                     )
-    return ForceHistory(times * t_scale, forces * f_scale, label, direction)
+                continue
+            try:
+                vec = parse_direction(cell, "direction")
+            except InputError:
+                raise InputError(
+                    "cannot read the direction (x, -z, or three numbers '1 0 0')",
+                    where=f"{where}, line {linenos[r]}",
+                ) from None
+            seen[cell] = vec
+            if direction is None:
+                direction = vec
+            elif not np.allclose(vec, direction, rtol=0, atol=1e-12):
+                raise InputError(
+                    "direction changes; use fx, fy, fz columns for a direction that varies",
+                    where=f"{where}, line {linenos[r]}",
+                )
+    return ForceHistory(times, values[0], label, direction)
 
 
 # ------------------------------------------------------------------------------------ library
@@ -348,11 +643,16 @@ class Activity:
     source: str
     durations: str
 
-    def history(self, name: str | None = None, **overrides: float) -> ForceHistory:
-        """The force history, with any of f0 (N), t1, t13, t14 (s) overridden."""
+    def pushoff(self, **overrides: float) -> CrewPushoff:
+        """The validated crew force, with any of f0 (N), t1, t13, t14 (s) overridden."""
         params = {"f0": self.f0, "t1": self.t1, "t13": self.t13, "t14": self.t14}
         params.update(overrides)
-        return crew_pushoff(name=name or self.name, **params)
+        return CrewPushoff(**params)
+
+    def history(self, name: str | None = None, **overrides: float) -> ForceHistory:
+        """The force history, with any of f0 (N), t1, t13, t14 (s) overridden."""
+        t, f = self.pushoff(**overrides).breakpoints()
+        return ForceHistory(t, f, name or self.name)
 
 
 @lru_cache(maxsize=1)
@@ -382,53 +682,81 @@ def known_force_specs() -> list[str]:
 
 
 _PARAM_DIMENSION = {"f0": "force", "t1": "time", "t13": "time", "t14": "time"}
+_PARAMS_FIX = (
+    "parameters are f0=<force>, t1=<time>, t13=<time>, t14=<time>, each at most once, "
+    "e.g. crew-pushoff:f0=40lbf,t1=0.5s"
+)
 
 
 def _parse_params(text: str, where: str) -> dict[str, float]:
     params: dict[str, float] = {}
-    for item in filter(None, (p.strip() for p in text.split(","))):
+    if re.search(r"[0-9],[0-9]", text):  # t1=1,5s: a decimal comma, not two parameters
+        raise InputError(
+            "a comma between digits (a decimal comma?)",
+            where=where,
+            fix="write the decimal point as '.', e.g. t1=1.5s; commas separate parameters",
+        )
+    for item in (p.strip() for p in text.split(",")):
+        if not item:
+            raise InputError(
+                "empty parameter (two commas, or a trailing comma)", where=where, fix=_PARAMS_FIX
+            )
         key, sep, value = item.partition("=")
         key = key.strip()
         if not sep or key not in _PARAM_DIMENSION:
-            raise InputError(
-                f"cannot read parameter {item!r}",
-                where=where,
-                fix="parameters are f0=<force>, t1=<time>, t13=<time>, t14=<time>, "
-                "e.g. crew-pushoff:f0=40lbf,t1=0.5s",
-            )
+            raise InputError(f"cannot read parameter {item!r}", where=where, fix=_PARAMS_FIX)
+        if key in params:
+            raise InputError(f"parameter {key} is given twice", where=where, fix=_PARAMS_FIX)
         params[key] = parse_quantity(value.strip(), _PARAM_DIMENSION[key], where=f"{where}: {key}")
     return params
 
 
-def parse_force_spec(spec: str, *, where: str = "--force") -> ForceHistory:
-    """A force history from a CLI spec.
+def _is_file(path: Path) -> bool:
+    try:
+        return path.is_file()
+    except (OSError, ValueError):
+        return False
+
+
+def parse_force_spec(spec: str, *, where: str = "force") -> ForceHistory:
+    """A force history from a spec string.
 
     Accepted: ``crew-pushoff`` (the report's Eq. 2.16 values); ``crew-pushoff:f0=40lbf,t1=0.5s``
-    (any of f0, t1, t13, t14 with units); a library name (``foot-pushoff-max``,
-    ``hand-pushoff-mean``, ...; parameters may follow a colon the same way); or the path of a CSV
-    file (see :func:`from_csv`).
+    (any of f0, t1, t13, t14 with units, each at most once); a library name
+    (``foot-pushoff-max``, ``hand-pushoff-mean``, ...; parameters may follow a colon the same
+    way); or the path of a CSV file (see :func:`from_csv`).
 
     Parameters
     ----------
     spec : the spec text
-    where : option name for error messages
+    where : parameter name for error messages
     """
+    if not isinstance(spec, str):
+        raise InputError(f"expected a force spec string, got {type(spec).__name__}", where=where)
+    if len(spec) > MAX_SPEC or "\x00" in spec:
+        raise InputError(
+            f"the spec is longer than {MAX_SPEC} characters or holds a NUL character", where=where
+        )
     spec = spec.strip()
     lib = activity_library()
     head, sep, tail = spec.partition(":")
     key = head.strip().lower()
-    if key in ("crew-pushoff", *lib) and not Path(spec).is_file():
-        params = _parse_params(tail, f"{where} {spec}") if sep else {}
-        if key == "crew-pushoff":
-            return lib["report-pushoff"].history(name="crew-pushoff", **params)
-        return lib[key].history(name=None, **params)
     path = Path(spec)
-    if path.is_file() or path.suffix.lower() == ".csv":
-        if not path.is_file():
+    if key in ("crew-pushoff", *lib) and not _is_file(path):
+        params = _parse_params(tail, f"{where} {spec}") if sep else {}
+        try:
+            if key == "crew-pushoff":
+                return lib["report-pushoff"].history(name="crew-pushoff", **params)
+            return lib[key].history(name=None, **params)
+        except InputError as exc:
+            raise InputError(exc.what, where=f"{where} {spec}: {exc.where}", fix=exc.fix) from None
+    if _is_file(path) or path.suffix.lower() == ".csv":
+        if not _is_file(path):
             raise InputError(f"force file {spec!r} not found", where=where)
         return from_csv(path)
+    shown = spec if len(spec) <= 60 else spec[:57] + "..."
     raise InputError(
-        f"unknown force {spec!r}",
+        f"unknown force {shown!r}",
         where=where,
         fix=f"use one of {', '.join(known_force_specs())}, or the path of a CSV file",
     )
