@@ -1082,6 +1082,22 @@ class _Reader:
             ]
         )
 
+    def rows(self, value: Any, path: str) -> np.ndarray:
+        """Three unit rows (x, y, z axes in the basic frame), right-handed and orthonormal."""
+        ok = isinstance(value, list) and len(value) == 3
+        ok = ok and all(
+            isinstance(r, list)
+            and len(r) == 3
+            and all(isinstance(v, int | float) and not isinstance(v, bool) for v in r)
+            for r in value
+        )
+        if not ok:
+            raise self.err(path, "expected a frame name or three rows [[x...], [y...], [z...]]")
+        ax = np.array(value, float)
+        if not np.allclose(ax @ ax.T, np.eye(3), atol=1e-9) or np.linalg.det(ax) < 0:
+            raise self.err(path, "the rows are not orthonormal and right-handed")
+        return ax
+
     def section(self, t: dict[str, Any], p: str) -> BeamSection:
         if ("ei" in t) == ("ei_y" in t or "ei_z" in t) or (("ei_y" in t) != ("ei_z" in t)):
             raise self.err(f"{p}.ei", "give either ei, or both ei_y and ei_z")
@@ -1215,7 +1231,9 @@ class _Reader:
         pa = pos.get(a, np.zeros(3))
         pb = pos.get(b, pa) if b is not None else pa
         loc = self.vec(t["at"], f"{p}.at") if "at" in t else 0.5 * (pa + pb)
-        if "axes" in t:
+        if "axes" in t and isinstance(t["axes"], list):
+            axes = self.rows(t["axes"], f"{p}.axes")
+        elif "axes" in t:
             fr = t["axes"]
             if fr not in frames:
                 raise self.err(f"{p}.axes", f"unknown frame {fr!r}", f"known: {', '.join(frames)}")
@@ -1445,7 +1463,9 @@ def dump_graph(graph: GraphModel) -> str:
             f"stiffness = {{ {kk} }}",
             f"damping = {{ {cc} }}",
             f"at = {_tv(spr.location)}",
-            f"orientation = [{', '.join(f'{x:.17g}' for x in spr.axes[1])}]",
+            "axes = ["
+            + ", ".join("[" + ", ".join(f"{x:.17g}" for x in row) + "]" for row in spr.axes)
+            + "]",
             "",
         ]
     if graph.scalar_springs:
