@@ -800,26 +800,30 @@ def _contributions(
 
 
 def _intervals(t: np.ndarray, accel: np.ndarray, req: Requirement) -> dict[str, Any]:
-    """Band margins over consecutive intervals of REQUIREMENT_INTERVAL_S (PIMS practice)."""
+    """Worst band margin over consecutive intervals of REQUIREMENT_INTERVAL_S (PIMS practice).
+
+    Uses :func:`microg.environment.intervals.interval_products`; only bands one interval
+    resolves are judged.
+    """
+    from microg.environment.intervals import interval_products
+
     length = REQUIREMENT_INTERVAL_S
-    dt = float(t[1] - t[0])
-    per = int(round(length / dt))
-    count = t.size // per if per >= 8 else 0
-    if count == 0:
+    if t.size * (t[1] - t[0]) < length:
         return {"interval_s": length, "count": 0, "min_margin": None, "worst_start_s": None}
-    worst = np.inf
-    start = None
-    for i in range(count):
-        sl = slice(i * per, (i + 1) * per)
-        sub = assess(t[sl], accel[:, sl], req)
-        mm = float(np.min(sub.third_octave.margin)) if sub.third_octave.margin.size else np.inf
-        if mm < worst:
-            worst, start = mm, float(t[sl][0])
+    b = interval_products(t, accel, req, interval_s=length).bands
+    lim = b.limit_g[None, None, :]
+    with np.errstate(divide="ignore"):
+        margin = np.where(b.rms_g > 0, lim / np.where(b.rms_g > 0, b.rms_g, 1.0), np.inf)
+    margin = np.where(b.resolved[None, None, :], margin, np.inf)
+    per_interval = margin.min(axis=(1, 2))
+    i = int(np.argmin(per_interval))
+    worst = float(per_interval[i])
     return {
         "interval_s": length,
-        "count": count,
+        "count": int(per_interval.size),
         "min_margin": worst if np.isfinite(worst) else "inf",
-        "worst_start_s": start,
+        "worst_start_s": float(b.t_start_s[i]),
+        "judged_bands_hz": [float(c) for c in b.bands.center_hz[b.resolved]],
     }
 
 
@@ -948,6 +952,8 @@ def run_analysis(
                 absorber_mu=opts.absorber_mu,
             )
             observations[name] = replace(ob, isolation=adv)
+    for pname, ob in observations.items():
+        warnings += [f"{pname}: {w}" for w in ob.assessment.warnings]
     notes = _notes(model, opts, observations)
     name = getattr(model, "name", None) or structure.meta.get("model", "model")
     return Analysis(

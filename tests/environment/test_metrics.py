@@ -211,12 +211,16 @@ def test_no_resolved_band_is_not_a_pass():
     assert any("cannot be judged" in w for w in res.warnings)
 
 
-def test_unresolved_exceedance_is_warned_not_judged():
-    # 100 ug at 0.02 Hz on a 100-s record: far above 1.8 ug, in a band of 0.08 bins
+def test_unresolved_exceedance_is_not_a_pass():
+    # 100 ug at 0.02 Hz on a 100-s record: far above 1.8 ug, in a band of 0.08 bins.  Every
+    # resolved band is clean, but compliance cannot be shown in the unresolved one: not a pass
     a = 100e-6 * G0 * np.sqrt(2) * np.sin(2 * np.pi * 0.02 * TIME)
     res = assess(TIME, a[None, :], transient=None)
-    assert res.complies is True  # every resolved band is clean
-    assert any("not judged" in w and "0.0197" in w for w in res.warnings)
+    assert res.complies is False
+    assert any("not resolved" in w and "0.0197" in w for w in res.warnings)
+    # a tone well inside the resolved range, below its limit, still passes
+    ok = 2e-6 * G0 * np.sqrt(2) * np.sin(2 * np.pi * 1.0 * TIME)
+    assert assess(TIME, ok[None, :], transient=None).complies is True
     # the 0.02 Hz bin is shared by the 0.0156, 0.0197 and 0.0248 Hz bands (df = 0.01 Hz)
     assert 0.0197 in res.to_dict()["third_octave"]["unresolved_exceeding_hz"]
 

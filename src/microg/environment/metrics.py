@@ -17,8 +17,10 @@ Definitions (see docs/assessment.md):
   (Parseval).  Bands wholly above Nyquist are left out.
 * Resolved band: at least ``MIN_BINS`` (5) frequency bins in the band, a record at least
   ``MIN_TIME_BANDWIDTH`` (5) times 1/bandwidth long, wholly below Nyquist (and below the data's
-  anti-alias cutoff when one is given).  Only resolved bands enter ``complies``; the others are
-  listed with the reason.
+  anti-alias cutoff when one is given).  Only resolved bands are judged; the others are listed
+  with the reason.  An unresolved band whose estimate exceeds its limit makes ``complies``
+  false (compliance cannot be shown), with a warning naming the record length that would
+  resolve it.
 * Integrated acceleration, two named quantities:
   ``sliding`` (microg's, conservative): ``max over t of |int_t^{t+W} a dt|`` over the raw record,
   windows of ``W = 10 s`` starting at every sample (end interpolated in the running trapezoidal
@@ -253,9 +255,9 @@ class Assessment:
     rms_accel_g : RMS of the vector magnitude over the record (raw), g
     peak_accel_g_axis, rms_accel_g_axis : (naxes,) per axis (raw), g
     third_octave : band RMS, limits, margins, resolution of each band
-    complies : every resolved band of every axis within its limit, the peak within
-        ``peak_limit_g`` when the requirement has one, and every *verified* transient criterion
-        met; False when no band is resolved
+    complies : every resolved band of every axis within its limit, no unresolved band's
+        estimate above its limit, the peak within ``peak_limit_g`` when the requirement has one,
+        and every *verified* transient criterion met; False when no band is resolved
     peak_limit_g : the requirement's peak limit, g, or None
     worst_band : the resolved band and axis with the smallest margin (None: none resolved)
     mean_accel_g_axis : (naxes,) record mean (the quasi-steady part), g
@@ -861,9 +863,13 @@ def assess(
     over = ~judged & np.any(rms_g > limit, axis=0)
     for i in np.nonzero(over)[0]:
         warnings.append(
-            f"band {third.center_hz[i]:.4g} Hz is not judged ({br.reasons[i]}), but its band "
-            f"RMS estimate {rms_g[:, i].max():.3g} g exceeds its limit {limit[i]:.3g} g"
+            f"band {third.center_hz[i]:.4g} Hz is not resolved ({br.reasons[i]}), and its band "
+            f"RMS estimate {rms_g[:, i].max():.3g} g exceeds its limit {limit[i]:.3g} g: "
+            "compliance cannot be shown, so the verdict is not a pass; lengthen the record to "
+            "judge the band"
         )
+    if np.any(over):
+        complies = False
     if req.peak_limit_g is not None:
         complies = complies and peak <= req.peak_limit_g
     sliding = integrated_acceleration(t, a, window_s)
