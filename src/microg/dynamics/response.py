@@ -530,7 +530,9 @@ def _evaluate(
     """
     m, nt, nq = st.omega.size, t.size, len(qs)
     rows = m if project is None else project.shape[0]
-    out = np.zeros((nq, rows, nt))
+    # every entry is written below (np.empty: no zero-filled pages to fault in first)
+    out = np.empty((nq, rows, nt))
+    out[:, :, : int(np.searchsorted(t, st.starts[0], side="left"))] = 0.0  # before the force
     runs, rest = _runs(t, st.starts)
     scratch = None if project is None else np.empty((nq, m, min(_CHUNK, max(nt, 1))))
     for k, i0, i1 in runs:
