@@ -802,15 +802,15 @@ def _contributions(
 def _intervals(t: np.ndarray, accel: np.ndarray, req: Requirement) -> dict[str, Any]:
     """Worst band margin over consecutive intervals of REQUIREMENT_INTERVAL_S (PIMS practice).
 
-    Uses :func:`microg.environment.intervals.interval_products`; only bands one interval
+    Uses :func:`microg.environment.intervals.interval_band_rms`; only bands one interval
     resolves are judged.
     """
-    from microg.environment.intervals import interval_products
+    from microg.environment.intervals import interval_band_rms
 
     length = REQUIREMENT_INTERVAL_S
     if t.size * (t[1] - t[0]) < length:
         return {"interval_s": length, "count": 0, "min_margin": None, "worst_start_s": None}
-    b = interval_products(t, accel, req, interval_s=length).bands
+    b = interval_band_rms(t, accel, req, interval_s=length)
     lim = b.limit_g[None, None, :]
     with np.errstate(divide="ignore"):
         margin = np.where(b.rms_g > 0, lim / np.where(b.rms_g > 0, b.rms_g, 1.0), np.inf)

@@ -458,3 +458,19 @@ def test_overlay_of_a_prediction_and_a_measurement():
     assert {"IOC lab x", "SAMS 121f03 x", "limit"} <= set(labels)
     assert len(fig.axes[1].lines) == 2  # one PSD each, the worst axis by RMS
     assert isinstance(pred.plot("psd"), Figure)
+
+
+@pytest.mark.parametrize("n", [1000, 1001, 4])
+def test_periodogram_is_scipys(n):
+    # reference: scipy.signal.periodogram with the same definition (boxcar, density, one-sided);
+    # both are one FFT, so they agree to rounding (1e-12 of the largest bin)
+    from scipy import signal
+
+    from microg.environment.metrics import _periodogram
+
+    rng = np.random.default_rng(n)
+    x = rng.standard_normal((3, n))
+    f_ref, p_ref = signal.periodogram(x, fs=50.0, window="boxcar", detrend=False, axis=-1)
+    f, p = _periodogram(x, 50.0)
+    assert np.array_equal(f, f_ref)
+    assert np.allclose(p, p_ref, rtol=0, atol=1e-12 * p_ref.max())

@@ -29,7 +29,6 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from scipy import signal
 
 from microg.environment.metrics import (
     MAX_SAMPLES,
@@ -61,6 +60,7 @@ __all__ = [
     "CumulativeRMS",
     "IntervalAnalysis",
     "percentile_linear",
+    "interval_band_rms",
     "interval_products",
 ]
 
@@ -512,6 +512,89 @@ def _interval_spectrum(
     return acceleration_psd(t, x, method=method, segment_s=segment_s)
 
 
+def _interval_bands(
+    blocks: np.ndarray,
+    fs: float,
+    req: Requirement,
+    axes: tuple[str, ...],
+    t0: np.ndarray,
+    interval_s: float,
+    psd_method: str,
+    segment_s: float | None,
+    percentiles: tuple[float, ...],
+    cutoff_hz: float | None,
+) -> tuple[IntervalBandRMS, Spectrum]:
+    """Band RMS of each interval (blocks (naxes, ni, per)) against ``req``, and the spectra."""
+    naxes, ni, per = blocks.shape
+    iseg = None if segment_s is None else min(segment_s, interval_s)
+    spec_i = _interval_spectrum(blocks, fs, psd_method, iseg)
+    br = band_rms(
+        spec_i, req.bands, min_bins=MIN_BINS, min_time_bandwidth=MIN_TIME_BANDWIDTH,
+        cutoff_hz=cutoff_hz,
+    )  # fmt: skip
+    nb = br.bands.center_hz.size
+    rms = (br.rms / G0).reshape(naxes, ni, nb).transpose(1, 0, 2)  # (ni, naxes, nb)
+    rss = np.sqrt(np.sum(rms**2, axis=1))
+    limit = req.limit_g[req.bands.lower_hz < spec_i.nyquist_hz]
+    pct = percentile_linear(np.concatenate([rms, rss[:, None, :]], axis=1), percentiles, axis=0)
+    exceed = np.mean(rms > limit[None, None, :], axis=0)
+    bands = IntervalBandRMS(
+        axes=axes,
+        interval_s=interval_s,
+        t_start_s=t0,
+        bands=br.bands,
+        limit_g=limit,
+        requirement=req.name,
+        rms_g=rms,
+        rss_g=rss,
+        resolved=br.resolved,
+        reasons=br.reasons,
+        percentiles=tuple(float(p) for p in percentiles),
+        percentile_rms_g=pct,
+        exceed_fraction=exceed,
+    )
+    return bands, spec_i
+
+
+def interval_band_rms(
+    timepts: np.ndarray,
+    accel: np.ndarray,
+    requirement: Requirement | str | None = None,
+    *,
+    interval_s: float = 100.0,
+    axes: tuple[str, ...] = ("x", "y", "z"),
+    percentiles: tuple[float, ...] = PIMS_PERCENTILES,
+) -> IntervalBandRMS:
+    """Band RMS over consecutive intervals only (the first product of :func:`interval_products`).
+
+    Parameters
+    ----------
+    timepts : (nt,) uniformly spaced times, s
+    accel : (naxes, nt) acceleration, m/s^2
+    requirement : a :class:`Requirement` or its name (default ``iss``)
+    interval_s : interval length, s; the incomplete last interval is left out
+    axes : names of the rows of ``accel``
+    percentiles : percentiles over intervals, 0-100
+    """
+    a = _as_axes(accel)
+    t = np.asarray(timepts, dtype=float)
+    fs = _sample_rate(t)
+    per = int(round(interval_s * fs))
+    ni = a.shape[1] // per if per >= 8 else 0
+    if ni == 0:
+        raise InputError(
+            f"the record ({a.shape[1] / fs:.6g} s) is shorter than one {interval_s:g}-s interval",
+            where="interval_s",
+        )
+    req = requirement_by_name(requirement if requirement is not None else "iss")
+    blocks = a[:, : ni * per].reshape(a.shape[0], ni, per)
+    t0 = t[0] + np.arange(ni) * per / fs
+    names = tuple(axes)[: a.shape[0]]
+    return _interval_bands(
+        blocks, fs, req, names, t0, per / fs, "periodogram", None, percentiles, None
+    )[0]
+
+
 def interval_products(
     timepts: np.ndarray,
     accel: np.ndarray,
@@ -598,34 +681,10 @@ def interval_products(
     )
 
     # -- per-interval band RMS
-    iseg = None if segment_s is None else min(segment_s, per * dt)
-    spec_i = _interval_spectrum(blocks, fs, psd_method, iseg)
-    br = band_rms(
-        spec_i, req.bands, min_bins=MIN_BINS, min_time_bandwidth=MIN_TIME_BANDWIDTH,
-        cutoff_hz=cutoff_hz,
-    )  # fmt: skip
-    nb = br.bands.center_hz.size
-    rms = (br.rms / G0).reshape(a.shape[0], ni, nb).transpose(1, 0, 2)  # (ni, naxes, nb)
-    rss = np.sqrt(np.sum(rms**2, axis=1))
-    limit = req.limit_g[req.bands.lower_hz < spec_i.nyquist_hz]
-    pct = percentile_linear(np.concatenate([rms, rss[:, None, :]], axis=1), percentiles, axis=0)
-    exceed = np.mean(rms > limit[None, None, :], axis=0)
-    bands = IntervalBandRMS(
-        axes=axes,
-        interval_s=per * dt,
-        t_start_s=t0,
-        bands=br.bands,
-        limit_g=limit,
-        requirement=req.name,
-        rms_g=rms,
-        rss_g=rss,
-        resolved=br.resolved,
-        reasons=br.reasons,
-        percentiles=tuple(float(p) for p in percentiles),
-        percentile_rms_g=pct,
-        exceed_fraction=exceed,
+    bands, spec_i = _interval_bands(
+        blocks, fs, req, axes, t0, per * dt, psd_method, segment_s, percentiles, cutoff_hz
     )
-    if not np.any(br.resolved):
+    if not np.any(bands.resolved):
         warnings.append(
             f"no band of {req.name} is resolved by {per * dt:.4g}-s intervals: lengthen --interval"
         )
@@ -678,6 +737,8 @@ def interval_products(
             f"spectrogram: segments of {nseg * dt:.4g} s with {noverlap / nseg:.0%} overlap "
             f"to stay under {MAX_SPECTROGRAM_VALUES:,} values"
         )
+    from scipy import signal  # lazily: scipy.signal costs ~0.5 s to import
+
     f_s, t_s, sxx = signal.spectrogram(
         a,
         fs=fs,
