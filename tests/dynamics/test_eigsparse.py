@@ -1,4 +1,4 @@
-"""Tests of microg.dynamics.eigsparse: exact rigid modes plus deflated shift-invert."""
+"""Tests of microg.dynamics.eigsparse: exact rigid modes plus inverse iteration on G_e M."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import scipy.sparse as sp
 
 from microg.dynamics.eigsparse import solve_sparse
 from microg.dynamics.rigid import rigid_basis
-from microg.errors import SolverError
+from microg.errors import InputError
 
 
 def chain(n: int, k: float = 1.0e4, m: float = 2.0, cut: int | None = None):
@@ -51,10 +51,11 @@ def test_free_free_chain_matches_closed_form(dense_max):
 
 
 @pytest.mark.parametrize("dense_max", [0, 10**6], ids=["shift-invert", "dense"])
-def test_mechanism_raises_naming_the_count(dense_max):
+def test_mechanism_is_refused_naming_the_part(dense_max):
     n = 2200 if dense_max == 0 else 300
     M, K = chain(n, cut=100)  # two free pieces: one zero mode more than the rigid vector
-    with pytest.raises(SolverError, match="1 zero-frequency mode"):
+    # a mechanism is a modelling error (an unrestrained part): one line, the moving part named
+    with pytest.raises(InputError, match="mechanism.*coordinates"):
         solve_sparse(M, K, np.ones((n, 1)), n_modes=6, dense_max=dense_max)
 
 
@@ -85,5 +86,27 @@ def test_bad_input():
     M, K = chain(10)
     with pytest.raises(ValueError, match="not symmetric"):
         solve_sparse(M, sp.triu(K).tocsr(), None)
-    with pytest.raises(ValueError, match="positive definite"):
-        solve_sparse(sp.diags(np.r_[0.0, np.ones(9)]).tocsr(), K, None)
+    with pytest.raises(InputError, match="non-finite"):
+        solve_sparse(M, (K * np.nan).tocsr(), None)
+    with pytest.raises(InputError, match="n_modes"):
+        solve_sparse(M, K, None, n_modes=0)
+
+
+@pytest.mark.parametrize("dense_max", [0, 10**6], ids=["inverse-iteration", "dense"])
+def test_massless_coordinates_are_condensed_not_refused(dense_max):
+    # every other mass of a free-free chain is zero: the massless coordinates are condensed
+    # statically. Reference: the chain of the massive ones with two springs in series
+    # (k/2 each), whose closed form is chain_exact with k -> k/2 (issue 10 section 1c)
+    n = 2 * 1200 + 1 if dense_max == 0 else 2 * 150 + 1
+    M, K = chain(n)
+    M = sp.diags(np.where(np.arange(n) % 2 == 0, 2.0, 0.0), format="csr")
+    sol = solve_sparse(M, K, np.ones((n, 1)), n_modes=8, dense_max=dense_max)
+    exact = chain_exact((n + 1) // 2, k=0.5e4)[:8]
+    assert sol.rigid.sum() == 1 and sol.omega[0] == 0.0
+    # eigenvalue round-off eps lambda_max / lambda_1 ~ 1e-10 (as in the chain test above)
+    np.testing.assert_allclose(sol.omega[1:], exact[1:], rtol=1e-9)
+    phi = sol.phi
+    # the massless coordinates hold the static response: the mean of their neighbours
+    inner = np.arange(1, n - 1, 2)
+    np.testing.assert_allclose(phi[inner], 0.5 * (phi[inner - 1] + phi[inner + 1]), atol=1e-10)
+    np.testing.assert_allclose(phi.T @ (M @ phi), np.eye(8), atol=1e-10)

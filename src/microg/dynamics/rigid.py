@@ -1,17 +1,19 @@
 """Exact rigid-body modes: the part of the rigid-body span that the stiffness annihilates.
 
 Rigid-body modes are never left to an eigensolver's round-off.  A discretisation declares
-the exact rigid-body vectors (unit translations and rotations); :func:`rigid_basis` keeps
-the combinations that ``K`` annihilates row by row and returns them M-orthonormal.  Both
-solvers (:mod:`microg.dynamics.dense`, :mod:`microg.dynamics.eigsparse`) use it.
+the exact rigid-body vectors (unit translations and rotations about the centre of mass);
+:func:`rigid_basis` keeps the combinations that ``K`` annihilates row by row and returns them
+M-orthonormal.  Both solvers (:mod:`microg.dynamics.dense`, :mod:`microg.dynamics.eigsparse`)
+use it, and :func:`support_coordinates` picks where to hold a free structure isostatically.
 """
 
 from __future__ import annotations
 
 import numpy as np
+import scipy.linalg as sla
 import scipy.sparse as sp
 
-__all__ = ["RIGID_TOL", "rigid_basis", "m_orthonormal", "rowwise_small"]
+__all__ = ["RIGID_TOL", "rigid_basis", "m_orthonormal", "rowwise_small", "support_coordinates"]
 
 #: row-wise relative tolerance for deciding that K annihilates a rigid-body vector:
 #: exact rigid vectors of the frame models score ~1e-16; a restraint softer than 1e-12 of a
@@ -42,7 +44,8 @@ def rigid_basis(
     Returns
     -------
     ndarray (n, r0)
-        ``B`` with ``B^T M B = I`` and ``K B = 0`` to round-off.
+        ``B`` with ``B^T M B = I`` and ``K B = 0`` to round-off, in the order of the
+        candidates that pass (Gram-Schmidt in the mass inner product).
     """
     n = mass.shape[0]
     if candidates is None or np.size(candidates) == 0:
@@ -73,10 +76,24 @@ def rigid_basis(
         accepted = np.concatenate([accepted, g[:, good]], axis=1)
     if accepted.shape[1] == 0:
         return np.zeros((n, 0))
-    ma = accepted.T @ mcc @ accepted
-    w, v = np.linalg.eigh(0.5 * (ma + ma.T))
-    keep = w > 1e-12 * w.max()
-    return c @ (accepted @ (v[:, keep] / np.sqrt(w[keep])))
+    return c @ _m_orthonormal_coefficients(accepted.T @ mcc @ accepted, accepted)
+
+
+def _m_orthonormal_coefficients(gram: np.ndarray, coef: np.ndarray) -> np.ndarray:
+    """Coefficients making ``coef`` orthonormal in ``gram``: Gram-Schmidt (Cholesky) in order.
+
+    Keeping the order keeps the rigid modes named (x, y, z translations, then rotations about
+    the centre of mass, each orthogonalised against the earlier ones); a dependent or
+    massless direction falls back to the eigen-decomposition, dropping it.
+    """
+    g = 0.5 * (gram + gram.T)
+    w = np.linalg.eigvalsh(g) if g.size else np.zeros(0)
+    if w.size and w.min() > 1e-10 * w.max():
+        r = sla.cholesky(g, lower=False)
+        return coef @ sla.solve_triangular(r, np.eye(g.shape[0]))
+    w, v = np.linalg.eigh(g)
+    keep = w > 1e-12 * max(w.max(), 1e-300)
+    return coef @ (v[:, keep] / np.sqrt(w[keep]))
 
 
 def rowwise_small(kx: np.ndarray, ax: np.ndarray, tol: float) -> np.ndarray:
@@ -87,8 +104,33 @@ def rowwise_small(kx: np.ndarray, ax: np.ndarray, tol: float) -> np.ndarray:
 
 
 def m_orthonormal(M: sp.spmatrix, c: np.ndarray) -> np.ndarray:
-    """M-orthonormal basis of span(c), dependent columns dropped."""
+    """M-orthonormal basis of span(c), dependent or massless columns dropped (order kept)."""
+    c = np.asarray(c, float)
+    if c.size == 0:
+        return c.reshape(M.shape[0], 0)
     mc = c.T @ (M @ c)
-    w, v = np.linalg.eigh(0.5 * (mc + mc.T))
-    keep = w > 1e-12 * w.max()
-    return c @ (v[:, keep] / np.sqrt(w[keep]))
+    return c @ _m_orthonormal_coefficients(mc, np.eye(c.shape[1]))
+
+
+def support_coordinates(basis: np.ndarray) -> np.ndarray:
+    """``r`` coordinates that hold a free structure isostatically (its rigid motions fixed).
+
+    The rows of the rigid basis (n, r) best conditioned as an r x r block, by QR with column
+    pivoting of its transpose: with these coordinates held at zero no rigid motion is left,
+    and the remaining stiffness is definite (Geradin & Rixen, Sec. 4.3).
+
+    Parameters
+    ----------
+    basis : ndarray (n, r)
+        Rigid-body vectors.
+
+    Returns
+    -------
+    ndarray (r,) of int
+        Coordinate indices, sorted.
+    """
+    r = basis.shape[1]
+    if r == 0:
+        return np.zeros(0, int)
+    _, _, piv = sla.qr(np.asarray(basis, float).T, mode="economic", pivoting=True)
+    return np.sort(piv[:r])

@@ -26,6 +26,10 @@ Modelling assumptions, each a documented choice:
 * **Torsionally free input** (``gj`` = 0, allowed by the model format for the planar report
   models) is treated as torsionally rigid, ``GJ = 1e4 max(EI)``: the report's assumed modes
   carry the solar boom round with the keel's rotation, and a free twist would be a mechanism.
+  **The rule: a torsional stiffness ``gj <= GJ_ZERO_FRACTION max(EI_y, EI_z)``
+  (``GJ_ZERO_FRACTION = 1e-12``) is numerically zero and is treated exactly like ``gj = 0``**
+  (so ``gj = "1e-30 lbf*ft^2"`` and ``gj = 0`` give the same structure).  A torsion mode
+  1e-6 of a bending frequency (``GJ/EI`` down to 1e-12) is still modelled as given.
 * **Rigid bodies.**  A body's master node is at its attach point when it rides on a beam
   (the master *is* that beam node), else at the root of the first beam cantilevered from
   it, else at the centre of mass of its point masses.  Its point masses are lumped into the
@@ -40,6 +44,23 @@ Modelling assumptions, each a documented choice:
   master rotations.  The exact linearised roll-yaw equations (with gyroscopic coupling and
   ``4 w0^2`` on roll) differ; like the report, this keeps pitch exact and roll approximate.
   Elastic modes change by the same tiny relative amount as in the Ritz model (~1e-7).
+  When ``I_z`` is not the smallest moment the restoring stiffness is negative: the attitude
+  is unstable, and the solver reports that libration as an unstable mode (a growth rate, not
+  a frequency) instead of refusing the model.
+* **Rigid-body vectors** (:attr:`Structure.rigid_body`) are exact unit translations and unit
+  rotations **about the station's centre of mass** (not the origin), so that they, and the
+  rigid modes, do not depend on where the model sits in its frame.
+* **Exact flexibility** (:class:`FrameTree`).  The model is a tree: every node but the root
+  body's master is the far end of exactly one element.  With ``d_e = x_b - x_a`` the
+  element's deformation is ``delta_e = q_b - T(d_e) q_a`` (``T`` the rigid link) and
+  ``K = C^T D C`` with ``C`` unit lower triangular (nodes are numbered parents first) and
+  ``D`` the block diagonal of the elements' cantilever stiffnesses (plus the gravity-gradient
+  restraint of the root).  So ``G = C^-1 D^+ C^-T`` is a generalized inverse of ``K``
+  (``K G K = K``) computed without cancellation: loads are summed from the tips to the
+  root, deformations from the closed-form cantilever flexibilities, displacements summed
+  back out.  The assembled ``K`` loses the lowest modes of fine meshes to round-off
+  (relative error ~ eps (L/h)^4: 4e-3 at 10,000 elements on a beam); ``G`` keeps them to
+  ~ eps L/h.  :func:`microg.dynamics.eigsparse.solve_sparse` uses it.
 """
 
 from __future__ import annotations
@@ -56,6 +77,8 @@ from microg.models.station import POLAR_GYRATION_FRACTION, Beam, PointMass, Rigi
 from microg.structure.structure import PointMap, Structure
 
 __all__ = [
+    "FrameStructure",
+    "FrameTree",
     "NodeSamples",
     "build_fem",
     "constrain",
@@ -64,9 +87,14 @@ __all__ = [
     "frame_stiffness_local",
     "point_mass_matrix",
     "rigid_link",
+    "torsion_is_rigid",
+    "cantilever_flexibility_local",
     "DOF_NAMES",
     "AXIAL_PENALTY",
     "TORSION_PENALTY",
+    "GJ_ZERO_FRACTION",
+    "MAX_STIFFNESS_RATIO",
+    "check_stiffness_contrast",
     "POLAR_GYRATION_FRACTION",
 ]
 
@@ -76,6 +104,14 @@ DOF_NAMES = ("ux", "uy", "uz", "rx", "ry", "rz")
 AXIAL_PENALTY = 1e6
 #: torsionally rigid beams (gj = 0): GJ = TORSION_PENALTY * max(EI_y, EI_z)
 TORSION_PENALTY = 1e4
+#: a torsional stiffness at most this fraction of max(EI_y, EI_z) is numerically zero and is
+#: treated as gj = 0 (the rule of docs/model-format.md: 1e-30 lbf*ft^2 behaves like 0)
+GJ_ZERO_FRACTION = 1e-12
+#: largest accepted ratio of the bending stiffnesses (EI) of two beams of one model.  Real
+#: stations span a few decades (a truss 1e10 N m^2, a light antenna 1e3 N m^2); in double
+#: precision a soft part 1e-12 of the stiff one keeps only ~4 digits in the rows where they
+#: join, and beyond 1e16 it is lost entirely (documented in docs/model-format.md)
+MAX_STIFFNESS_RATIO = 1e12
 #: default number of elements per beam when neither discretisation option is given
 DEFAULT_ELEMENTS_PER_BEAM = 10
 
@@ -247,6 +283,188 @@ def constrain(
     return m.tocsr(), k.tocsr(), free
 
 
+# --------------------------------------------------------------------------- exact flexibility
+
+
+def cantilever_flexibility_local(
+    length: np.ndarray, ea: np.ndarray, ei_y: np.ndarray, ei_z: np.ndarray, gj: np.ndarray
+) -> np.ndarray:
+    """Tip flexibility of frame elements clamped at their first end, local axes (closed form).
+
+    The inverse of the far-end block ``k[6:, 6:]`` of :func:`frame_stiffness_local`: axial
+    ``L/EA``, torsion ``L/GJ``, bending ``L/EI [[L^2/3, L/2], [L/2, 1]]`` for ``(v, theta_z)``
+    and with the sign of ``theta_y = -dw/dx`` for ``(w, theta_y)`` (tip deflection and slope
+    of a cantilever under a tip force and a tip moment, e.g. Roark, Table 8.1 cases 1a, 3a).
+
+    Parameters
+    ----------
+    length : ndarray (ne,)
+        Element lengths, m.
+    ea : ndarray (ne,)
+        Axial stiffness, N.
+    ei_y, ei_z : ndarray (ne,)
+        Bending stiffness about local y and local z, N m^2.
+    gj : ndarray (ne,)
+        Torsional stiffness, N m^2.
+
+    Returns
+    -------
+    ndarray (ne, 6, 6)
+        m/N, 1/N, rad/(N m) per unit tip load (u, v, w, theta_x, theta_y, theta_z).
+    """
+    L = np.asarray(length, float)
+    f = np.zeros((L.size, 6, 6))
+    f[:, 0, 0] = L / np.asarray(ea, float)
+    f[:, 3, 3] = L / np.asarray(gj, float)
+    for ei, (t, r, sign) in (
+        (np.asarray(ei_z, float), (1, 5, 1.0)),
+        (np.asarray(ei_y, float), (2, 4, -1.0)),
+    ):
+        f[:, t, t] = L**3 / (3.0 * ei)
+        f[:, t, r] = f[:, r, t] = sign * L**2 / (2.0 * ei)
+        f[:, r, r] = L / ei
+    return f
+
+
+@dataclass(frozen=True)
+class FrameTree:
+    """The tree of a frame model, for its exact generalized inverse ``G = C^-1 D^+ C^-T``.
+
+    ``K = C^T D C``: ``(C q)_b = q_b - T(d_e) q_a`` for the element ``e`` from node ``a`` to
+    node ``b`` (``T`` the rigid link, ``d_e = x_b - x_a``), ``(C q)_root = q_root``; ``D`` is
+    block diagonal with each element's cantilever stiffness (station axes) and, for the root,
+    the gravity-gradient restraint.  The module docstring says why ``G`` is accurate.
+
+    Attributes
+    ----------
+    n_nodes : int
+    root : int
+        Node of the root body (the tree's root).
+    parent, child : ndarray (ne,) of int
+        Nodes ``a`` and ``b`` of each element (``child`` holds every node but the root once).
+    offset : ndarray (ne, 3)
+        ``x_b - x_a``, m.
+    flexibility : ndarray (ne, 6, 6)
+        Cantilever flexibility of each element in station axes (``D_e^-1``).
+    root_stiffness : ndarray (6,)
+        Restraint of the root's six coordinates (N/m, N m/rad): the gravity gradient on roll
+        and pitch, zero elsewhere (negative for an unstable attitude).
+    free : tuple of str
+        The rigid-body directions ``K`` annihilates exactly (keys of ``rigid_body``).
+    """
+
+    n_nodes: int
+    root: int
+    parent: np.ndarray
+    child: np.ndarray
+    offset: np.ndarray
+    flexibility: np.ndarray
+    root_stiffness: np.ndarray
+    free: tuple[str, ...]
+
+    def kinematics(self) -> sp.csr_matrix:
+        """The unit lower-triangular matrix ``C`` (nodes are numbered parents first)."""
+        n = 6 * self.n_nodes
+        t = rigid_link(self.offset)
+        rr = 6 * self.child[:, None, None] + np.arange(6)[None, :, None]
+        cc = 6 * self.parent[:, None, None] + np.arange(6)[None, None, :]
+        rows = np.concatenate([np.arange(n), np.broadcast_to(rr, t.shape).ravel()])
+        cols = np.concatenate([np.arange(n), np.broadcast_to(cc, t.shape).ravel()])
+        vals = np.concatenate([np.ones(n), -t.ravel()])
+        c = sp.csr_matrix((vals, (rows, cols)), shape=(n, n))
+        c.eliminate_zeros()
+        return c
+
+    def stiffness_blocks(self) -> np.ndarray:
+        """``D``'s element blocks (ne, 6, 6): the inverse of :attr:`flexibility`."""
+        return np.linalg.inv(self.flexibility)
+
+    def factor(self) -> TreeFlexibility:
+        """An operator applying ``G`` (the triangular factor is made once, O(n))."""
+        return TreeFlexibility(self)
+
+
+class TreeFlexibility:
+    """Applies the generalized inverse ``G = C^-1 D^+ C^-T`` of a tree frame's stiffness.
+
+    Parameters
+    ----------
+    tree : FrameTree
+    """
+
+    def __init__(self, tree: FrameTree) -> None:
+        import scipy.sparse.linalg as spla
+
+        self.tree = tree
+        self.n = 6 * tree.n_nodes
+        # C is unit lower triangular: no pivoting, no fill (L = C, U = I)
+        self._lu = spla.splu(tree.kinematics().tocsc(), permc_spec="NATURAL", diag_pivot_thresh=0.0)
+        k = np.asarray(tree.root_stiffness, float)
+        self._root_inv = np.divide(1.0, k, out=np.zeros(6), where=k != 0.0)
+        self._child = 6 * tree.child[:, None] + np.arange(6)
+        self._root = 6 * tree.root + np.arange(6)
+
+    def __call__(self, y: np.ndarray) -> np.ndarray:
+        """``G y`` for ``y`` (n,) or (n, k): N and N m in, m and rad out."""
+        y = np.asarray(y, float)
+        one = y.ndim == 1
+        yy = y.reshape(self.n, -1)
+        z = self._lu.solve(yy, trans="T")  # internal forces carried by each element
+        w = np.zeros_like(z)
+        w[self._child] = np.einsum("eij,ejk->eik", self.tree.flexibility, z[self._child])
+        w[self._root] = self._root_inv[:, None] * z[self._root]
+        x = self._lu.solve(w)  # deformations summed out from the root
+        return x.ravel() if one else x
+
+
+def _frame_tree(
+    P: np.ndarray,
+    a: np.ndarray,
+    b: np.ndarray,
+    R: np.ndarray,
+    length: np.ndarray,
+    props: np.ndarray,
+    root: int,
+    root_k: np.ndarray,
+    free: tuple[str, ...],
+) -> FrameTree | None:
+    """The :class:`FrameTree` of an assembled mesh, or None if it is not a tree rooted there."""
+    nn = P.shape[0]
+    seen = np.zeros(nn, int)
+    np.add.at(seen, b, 1)
+    seen[root] += 1
+    if np.any(seen != 1) or np.any(a >= b):
+        return None  # not a tree numbered parents first: the generic solver handles it
+    f_loc = cantilever_flexibility_local(length, props[:, 0], props[:, 1], props[:, 2], props[:, 3])
+    r6 = np.zeros((length.size, 6, 6))
+    r6[:, :3, :3] = R
+    r6[:, 3:, 3:] = R
+    flex = np.swapaxes(r6, 1, 2) @ f_loc @ r6
+    return FrameTree(
+        n_nodes=nn,
+        root=int(root),
+        parent=np.asarray(a, int),
+        child=np.asarray(b, int),
+        offset=P[b] - P[a],
+        flexibility=0.5 * (flex + np.swapaxes(flex, 1, 2)),
+        root_stiffness=np.asarray(root_k, float),
+        free=free,
+    )
+
+
+@dataclass(frozen=True)
+class FrameStructure(Structure):
+    """A :class:`~microg.structure.Structure` of frame elements that knows its tree.
+
+    Attributes
+    ----------
+    tree : FrameTree or None
+        The exact flexibility's data (None for a model without beams).
+    """
+
+    tree: FrameTree | None = None
+
+
 # --------------------------------------------------------------------------- samples
 
 
@@ -365,11 +583,52 @@ def _body_reference(body: RigidBody, station: Station) -> np.ndarray:
     return np.zeros(3)
 
 
+def torsion_is_rigid(beam: Beam) -> bool:
+    """True when ``beam``'s torsional stiffness is zero or numerically zero.
+
+    The rule (docs/model-format.md): ``gj <= GJ_ZERO_FRACTION max(EI_y, EI_z)`` is treated
+    exactly like ``gj = 0``, i.e. torsionally rigid.
+
+    Parameters
+    ----------
+    beam : Beam
+    """
+    return not beam.gj > GJ_ZERO_FRACTION * max(beam.ei_y, beam.ei_z)
+
+
+def check_stiffness_contrast(station: Station) -> None:
+    """Refuse bending stiffnesses more than :data:`MAX_STIFFNESS_RATIO` apart.
+
+    Parameters
+    ----------
+    station : Station
+
+    Raises
+    ------
+    InputError
+        Naming the softest beam, with the ratio.
+    """
+    if not station.beams:
+        return
+    ei = np.array([[b.ei_y, b.ei_z] for b in station.beams], float)
+    lo, hi = np.unravel_index(np.argmin(ei), ei.shape), np.unravel_index(np.argmax(ei), ei.shape)
+    ratio = ei[hi] / ei[lo]
+    if ratio > MAX_STIFFNESS_RATIO:
+        soft, stiff = station.beams[lo[0]].name, station.beams[hi[0]].name
+        raise InputError(
+            f"bending stiffness of beam {soft!r} is {ratio:.3g} times smaller than that of "
+            f"{stiff!r}, beyond the limit {MAX_STIFFNESS_RATIO:g} that double precision "
+            "resolves",
+            where=f"beam {soft}",
+            fix="check the value and its unit, or model the soft part as a point mass",
+        )
+
+
 def _effective_properties(beam: Beam) -> tuple[float, float, float]:
     """Axial stiffness (N), torsional stiffness (N m^2) and rho J (kg m) used for ``beam``."""
     ei_max = max(beam.ei_y, beam.ei_z)
     ea = beam.ea if beam.ea is not None else AXIAL_PENALTY * ei_max / beam.length**2
-    gj = beam.gj if beam.gj > 0 else TORSION_PENALTY * ei_max
+    gj = TORSION_PENALTY * ei_max if torsion_is_rigid(beam) else beam.gj
     return float(ea), float(gj), beam.polar_mass_per_length
 
 
@@ -413,6 +672,16 @@ def build_fem(
         )
     if not station.bodies:
         raise InputError("the station has no rigid body", fix="add a root [[body]]")
+    check_stiffness_contrast(station)
+    for body in station.bodies[1:]:
+        if body.parent is None:
+            # a second free body is joined to nothing: six free motions (a mechanism)
+            raise InputError(
+                f"body {body.name!r} is attached to nothing (only the first body is the root): "
+                "the structure has a mechanism, six free motions of that body",
+                where=f"body {body.name}",
+                fix="give it a parent beam and an attach point",
+            )
 
     mesh = _Mesh()
     for body in station.bodies:
@@ -538,22 +807,37 @@ def build_fem(
 
     total, cm, inertia = _mass_properties(station)
     root_node = mesh.body_node[station.bodies[0].name]
+    root_k = np.zeros(6)
     if gravity_gradient:
+        # Eqs. 2.27-2.28 on the root's rotations; negative when I_z is not the smallest
+        # moment (an unstable attitude: the solver reports it as an unstable libration)
         w2 = station.orbit.omega0**2
         ix, iy, iz = np.diag(inertia)
-        k_roll, k_pitch = 3.0 * w2 * (iy - iz), 3.0 * w2 * (ix - iz)
-        if k_roll < 0 or k_pitch < 0:
-            raise InputError(
-                "gravity gradient makes the attitude unstable (I_z is not the smallest moment)",
-                fix="use gravity_gradient=False or a model whose keel lies along z",
-            )
+        root_k[3:5] = 3.0 * w2 * (iy - iz), 3.0 * w2 * (ix - iz)
         gg = sp.coo_matrix(
-            ([k_roll, k_pitch], ([6 * root_node + 3, 6 * root_node + 4],) * 2), shape=(n, n)
+            (root_k[3:5], ([6 * root_node + 3, 6 * root_node + 4],) * 2), shape=(n, n)
         )
         K = (K + gg).tocsr()
 
     labels = tuple(f"{name}:{c}" for name in mesh.names for c in DOF_NAMES)
-    rigid = _rigid_vectors(P)
+    rigid = _rigid_vectors(P, cm)
+    tree = None
+    if station.beams:
+        tree = _frame_tree(
+            P,
+            np.concatenate(el["a"]),
+            np.concatenate(el["b"]),
+            R,
+            length,
+            pr,
+            root_node,
+            root_k,
+            tuple(
+                c
+                for c, k in zip(("x", "y", "z", "rx", "ry", "rz"), root_k, strict=True)
+                if k == 0.0
+            ),
+        )
     points = {}
     for p in station.points:
         node, off = mesh.locate(station, p.on, p.position)
@@ -567,7 +851,7 @@ def build_fem(
         )
 
     samples = _samples(station, mesh, P)
-    return Structure(
+    return FrameStructure(
         mass=M,
         stiffness=K,
         dof_labels=labels,
@@ -593,9 +877,11 @@ def build_fem(
                 f"axially rigid beams: EA = {AXIAL_PENALTY:g} max(EI)/L^2; "
                 f"gj = 0: GJ = {TORSION_PENALTY:g} max(EI); polar mass rho J = m'(EI_y+EI_z)/EA, "
                 f"or m'({POLAR_GYRATION_FRACTION:g} L)^2 without ea; "
-                "inertia_cm includes the beams' polar mass moments"
+                "inertia_cm includes the beams' polar mass moments; "
+                f"gj <= {GJ_ZERO_FRACTION:g} max(EI) is treated as gj = 0"
             ),
         },
+        tree=tree,
     )
 
 
@@ -608,10 +894,16 @@ def _mass_properties(station: Station) -> tuple[float, np.ndarray, np.ndarray]:
     return total, cm, inertia
 
 
-def _rigid_vectors(P: np.ndarray) -> dict[str, np.ndarray]:
-    """Unit rigid translations and rotations about the station origin, per node."""
+def _rigid_vectors(P: np.ndarray, center: np.ndarray | None = None) -> dict[str, np.ndarray]:
+    """Unit rigid translations and rotations about ``center`` (the centre of mass), per node.
+
+    The lever arms ``P - center`` are formed once, exactly as the model's own offsets, so
+    the vectors do not depend on where the model sits in its frame (about the origin, a model
+    50 m away carries 50 m lever arms whose rounding is ~1e-14 of the rows of ``K r``).
+    """
     out = {}
     nn = P.shape[0]
+    arm = P - (np.zeros(3) if center is None else np.asarray(center, float))
     for i, d in enumerate(("x", "y", "z")):
         v = np.zeros((nn, 6))
         v[:, i] = 1.0
@@ -620,7 +912,7 @@ def _rigid_vectors(P: np.ndarray) -> dict[str, np.ndarray]:
         axis = np.zeros(3)
         axis[i] = 1.0
         v = np.zeros((nn, 6))
-        v[:, :3] = np.cross(axis, P)
+        v[:, :3] = np.cross(axis, arm)
         v[:, 3 + i] = 1.0
         out[d] = v.ravel()
     return out
