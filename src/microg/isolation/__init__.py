@@ -7,33 +7,38 @@ Modules: :mod:`~microg.isolation.transmissibility` (kernels of Eqs. 4.3-4.7),
 :mod:`~microg.plotting.isolation` (Figure 8).
 """
 
-from microg.isolation.absorber import (
-    AbsorberTuning,
-    den_hartog,
-    den_hartog_peak_bound,
-    h2_closed_form,
-    h2_integral,
-    peak_over_band,
-    tune_absorber,
-)
-from microg.isolation.design import (
-    ClaimCheck,
-    MountDesign,
-    Section42Claims,
-    check_section42_claims,
-    design_mount,
-    max_stiffness_no_absorber,
-)
-from microg.isolation.timedomain import IsolationTimeResponse, IsolatorModel, package_response
-from microg.isolation.transmissibility import (
-    absorber_tuning_ratio,
-    accel_magnification,
-    accel_magnification_grid,
-    accel_magnification_no_absorber,
-    spring_ratio_from_tuning,
-    transmissibility,
-    transmissibility_no_absorber,
-)
+from __future__ import annotations
+
+import importlib
+from typing import Any
+
+#: public name -> module (imported on first use: the absorber optimiser pulls in
+#: scipy.optimize and scipy.integrate, which the main job does not always need)
+_LAZY: dict[str, str] = {
+    "AbsorberTuning": "microg.isolation.absorber",
+    "ClaimCheck": "microg.isolation.design",
+    "IsolationTimeResponse": "microg.isolation.timedomain",
+    "IsolatorModel": "microg.isolation.timedomain",
+    "MountDesign": "microg.isolation.design",
+    "Section42Claims": "microg.isolation.design",
+    "absorber_tuning_ratio": "microg.isolation.transmissibility",
+    "accel_magnification": "microg.isolation.transmissibility",
+    "accel_magnification_grid": "microg.isolation.transmissibility",
+    "accel_magnification_no_absorber": "microg.isolation.transmissibility",
+    "check_section42_claims": "microg.isolation.design",
+    "den_hartog": "microg.isolation.absorber",
+    "den_hartog_peak_bound": "microg.isolation.absorber",
+    "design_mount": "microg.isolation.design",
+    "h2_closed_form": "microg.isolation.absorber",
+    "h2_integral": "microg.isolation.absorber",
+    "max_stiffness_no_absorber": "microg.isolation.design",
+    "package_response": "microg.isolation.timedomain",
+    "peak_over_band": "microg.isolation.absorber",
+    "spring_ratio_from_tuning": "microg.isolation.transmissibility",
+    "transmissibility": "microg.isolation.transmissibility",
+    "transmissibility_no_absorber": "microg.isolation.transmissibility",
+    "tune_absorber": "microg.isolation.absorber",
+}
 
 __all__ = [
     "AbsorberTuning",
@@ -60,3 +65,16 @@ __all__ = [
     "transmissibility_no_absorber",
     "tune_absorber",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module 'microg.isolation' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY))
