@@ -463,18 +463,28 @@ def _table_run(st: _State, k: int, tau: np.ndarray, qs: tuple[int, ...], dest: n
         [W.real, W.imag, np.ones_like(W.real), np.broadcast_to(rdt, W.shape)], axis=1
     )  # (me, 4, L)
     full_blocks = n // L
+    rem = n - full_blocks * L
     contiguous = el[-1] - el[0] + 1 == me
     rows = slice(int(el[0]), int(el[-1]) + 1) if contiguous else el
     target = dest[:, rows] if contiguous else np.empty((nq, me, n))
-    if full_blocks:
-        body = target[:, :, : full_blocks * L].reshape(nq, me, full_blocks, L)
-        if np.shares_memory(body, target):
-            np.matmul(lhs[:, :, :full_blocks], rhs, out=body)
-        else:  # pragma: no cover - a reshape of a last-axis slice is a view
-            target[:, :, : full_blocks * L] = (lhs[:, :, :full_blocks] @ rhs).reshape(nq, me, -1)
-    rem = n - full_blocks * L
-    if rem:
-        target[:, :, full_blocks * L :] = (lhs[:, :, -1, None, :] @ rhs[:, :, :rem])[:, :, 0]
+    # eta'' has no polynomial part: its rows need only the inner dimension 2
+    groups = [[iq for iq, q in enumerate(qs) if q < 2], [iq for iq, q in enumerate(qs) if q == 2]]
+    for grp, width in zip(groups, (4, 2), strict=True):
+        if not grp:
+            continue
+        sl = slice(grp[0], grp[-1] + 1)  # qs is ordered, so each group is a contiguous slice
+        lh, rh = lhs[sl, :, :, :width], rhs[:, :width]
+        tg = target[sl]
+        if full_blocks:
+            body = tg[:, :, : full_blocks * L].reshape(len(grp), me, full_blocks, L)
+            if np.shares_memory(body, tg):
+                np.matmul(lh[:, :, :full_blocks], rh, out=body)
+            else:  # pragma: no cover - a reshape of a last-axis slice is a view
+                tg[:, :, : full_blocks * L] = (lh[:, :, :full_blocks] @ rh).reshape(
+                    len(grp), me, -1
+                )
+        if rem:
+            tg[:, :, full_blocks * L :] = (lh[:, :, -1, None, :] @ rh[:, :, :rem])[:, :, 0]
     # stable recomputation of eta, eta' where omega tau < _SERIES_BELOW
     fix = [iq for iq, q in enumerate(qs) if q < 2]
     if fix:
