@@ -32,6 +32,9 @@ tables of exact exponentials and one batched matrix product (:func:`_table_run`)
 evaluated directly by the closed form.  :func:`response_at_points` contracts the modes with
 ``T phi`` block by block, never building the (3, modes, times) array.
 
+A damped term that has decayed below exp(-600) (1e-261) of its start is set to exactly 0: far
+below rounding, and it keeps subnormal numbers (slow arithmetic) out of the kernels.
+
 Exact peaks (:func:`peak_response`): the supremum of |a(t)| and of each axis over a window,
 including both one-sided limits at the force's jumps and the stationary points between samples,
 with a certified upper bound (see the function).
