@@ -40,10 +40,14 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from microg.dynamics.dense import (
+    ACCEPT_REL,
+    MASSLESS_TOL,
     RESIDUAL_TOL,
     Eigensolution,
     _finish,
+    _scaling,
     blas_threads,
+    graded_eigh,
     moving_components,
     solve_dense,
 )
@@ -122,20 +126,22 @@ def solve_sparse(
     if n_modes < 1:
         raise InputError(f"n_modes must be at least 1, got {n_modes}", where="n_modes")
     dense = n <= dense_max or 2 * n_modes >= n
-    if rigid_vectors is not None and not (dense and rigid_candidates is not None):
+    if rigid_vectors is not None:
         B = m_orthonormal(M, np.asarray(rigid_vectors, float).reshape(n, -1))
     else:
-        # a small model is solved as any other dense one: the same rigid basis from the
-        # same candidates, whatever built it
         B = rigid_basis(M, K, rigid_candidates, tol)
     r = B.shape[1]
-    if dense:
-        return solve_dense(M.toarray(), K.toarray(), labels=labels, rigid_vectors=B).truncate(
-            max(n_modes, r)
-        )
-    k_el = min(max(n_modes - r, 0), n - r - 1)
     if flexibility is not None and not _consistent(M, K, B, flexibility):
         flexibility = None  # stale (matrices replaced after the model was built)
+    if dense:
+        if flexibility is not None:
+            with blas_threads(n):
+                lam, X = _dense_with_flexibility(M.toarray(), K.toarray(), B, flexibility)
+            sol = _finish(M, K, B, lam, X, labels, [], check_zero=False)
+        else:
+            sol = solve_dense(M.toarray(), K.toarray(), labels=labels, rigid_vectors=B)
+        return sol.truncate(max(n_modes, r))
+    k_el = min(max(n_modes - r, 0), n - r - 1)
     generic = flexibility is None
     if generic:
         flexibility = _isostatic_inverse(K, B, labels)
@@ -152,6 +158,53 @@ def _consistent(M: sp.csr_matrix, K: sp.csr_matrix, B: np.ndarray, g: Operator) 
     x = g(ky - M @ (B @ (B.T @ ky)))
     x = x - B @ (B.T @ (M @ x))
     return bool(np.linalg.norm(K @ x - ky) <= 1e-6 * np.linalg.norm(abs(K) @ np.abs(y)))
+
+
+def _dense_with_flexibility(
+    M: np.ndarray, K: np.ndarray, B: np.ndarray, g: Operator
+) -> tuple[np.ndarray, np.ndarray]:
+    """All elastic modes of a small model whose exact flexibility ``G`` is known.
+
+    The lowest modes come from ``G_e M`` (no assembled ``K``: exact whatever the stiffness
+    spread, e.g. an axially rigid beam's penalty 1e6 times its bending stiffness), densely:
+    with ``M = F F^T``, ``S = F^T G_e F`` and ``x = G_e F v / mu``; those resolved to
+    :data:`~microg.dynamics.dense.ACCEPT_REL` (``lambda <= 1e4 lambda_min``) are kept.  The
+    others are solved by :func:`~microg.dynamics.dense.graded_eigh` in the M-orthogonal
+    complement of everything kept.
+    """
+    n = M.shape[0]
+    MB = M @ B
+    P = np.eye(n) - MB @ B.T  # P y = y - M B B^T y
+    ge = P.T @ np.asarray(g(P), float).reshape(n, n)
+    ge = 0.5 * (ge + ge.T)
+    w, v = np.linalg.eigh(0.5 * (M + M.T))
+    pos = w > MASSLESS_TOL * max(w.max(), 0.0)
+    F = v[:, pos] * np.sqrt(w[pos])
+    n_finite = int(np.count_nonzero(pos)) - B.shape[1]
+    S = F.T @ ge @ F
+    mu, V = np.linalg.eigh(0.5 * (S + S.T))
+    order = np.argsort(-np.abs(mu))
+    mu, V = mu[order], V[:, order]
+    mu_max = float(np.abs(mu[0])) if mu.size else 0.0
+    good = np.abs(mu) > 1e6 * _EPS * mu_max
+    lam = np.where(good, 1.0 / np.where(good, mu, 1.0), np.inf)
+    bound = np.where(good, _EPS * mu_max / np.where(good, mu, 1.0) ** 2, np.inf)
+    ok = np.flatnonzero(good & (bound <= ACCEPT_REL * np.abs(lam)))[: max(n_finite, 0)]
+    X = (ge @ (F @ V[:, ok])) / mu[ok]
+    lam0 = lam[ok]
+    if ok.size < n_finite:
+        # the higher modes: graded inverse iteration on the assembled K, in the complement
+        Q = sla.null_space(np.concatenate([MB, M @ X], axis=1).T)
+        quad = getattr(g, "quadratic", None)  # the tree's strain form: no cancellation
+        kc = quad(Q) if callable(quad) else Q.T @ K @ Q
+        mc = Q.T @ M @ Q
+        d = _scaling(kc, mc)
+        lam1, y = graded_eigh(d[:, None] * kc * d, d[:, None] * mc * d, n_finite - ok.size)
+        X = np.concatenate([X, Q @ (d[:, None] * y)], axis=1)
+        lam0 = np.concatenate([lam0, lam1])
+    X = X - B @ (MB.T @ X)
+    srt = np.argsort(lam0, kind="stable")
+    return lam0[srt], X[:, srt]
 
 
 def _isostatic_inverse(K: sp.csr_matrix, B: np.ndarray, labels: tuple[str, ...] | None) -> Operator:
