@@ -108,3 +108,34 @@ def test_many_ritz_functions_keep_the_libration_mode() -> None:
     modes = solve_modes(s)
     assert modes.n_rigid == 1
     assert modes.omega[1] == pytest.approx(1.911e-3, rel=1e-3)  # Eq. 2.30 with the model's I
+
+
+def test_modes_api_elastic_fraction_dict_xarray_plot() -> None:
+    # one "elastic" rule (not rigid, not unstable), effective-mass fractions of r^T M r that
+    # sum to 1 over a complete set (completeness), to_dict keys, to_xarray dims and units
+    s = build_ritz(load_station("ioc"), "xz", 3, gravity_gradient=True)
+    modes = solve_modes(s)
+    assert modes.elastic.tolist() == (~modes.rigid & ~modes.unstable).tolist()
+    assert modes.elastic[1] and modes.omega[1] < 3e-3  # the libration counts as elastic
+    frac = modes.effective_mass_fraction
+    assert frac["x"].sum() == pytest.approx(1.0, rel=1e-10)
+    d = modes.to_dict()
+    keys = {"omega", "freq_hz", "rigid", "modal_mass", "effective_mass", "unstable"}
+    assert keys | {"growth_rate_rad_s", "effective_mass_fraction", "elastic"} <= set(d["modes"][0])
+    ds = modes.to_xarray()
+    assert ds["phi"].dims == ("dof", "mode") and ds["omega"].attrs["units"] == "rad/s"
+    assert ds.sizes["mode"] == modes.n_modes and ds["modal_mass"].attrs["units"] == "kg"
+    from matplotlib.figure import Figure
+
+    fig = modes.plot()
+    assert isinstance(fig, Figure) and fig.axes[0].get_yscale() == "log"
+
+
+def test_blas_threads_limit_small_problems() -> None:
+    # small dense problems run on one BLAS thread (2 threads cost 100x on this machine)
+    from threadpoolctl import threadpool_info
+
+    from microg.dynamics.dense import blas_threads
+
+    with blas_threads(100):
+        assert all(i["num_threads"] == 1 for i in threadpool_info() if i["user_api"] == "blas")

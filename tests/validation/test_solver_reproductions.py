@@ -219,13 +219,13 @@ def test_500_stub_beams_on_one_body():
     # only for the few stub combinations that have a net force, so most of the cluster sits
     # at the clamped value (to its discretisation error, ~1e-6 at 10 elements)
     st = _model("stubs500")
-    m = solve_modes(build_fem(st), 60)
+    m = solve_modes(build_fem(st), 24)
     assert m.n_rigid == 6
     b = st.beams[0]
     clamped = (1.875104068711961 / b.length) ** 2 * np.sqrt(b.ei_y / b.mass_per_length)
     stub = m.omega[~m.rigid]
     stub = stub[np.abs(stub / clamped - 1) < 0.01]
-    assert stub.size >= 40
+    assert stub.size >= 12
     assert np.median(stub) == pytest.approx(clamped, rel=1e-5)
 
 
