@@ -129,6 +129,7 @@ def test_harmonic_response_is_frf_times_phasor(ritz):
     ms = np.abs(h[:, 0] * phasor[0]) ** 2 / 2 + np.abs(h[:, 1] * (phasor[1] + phasor[2])) ** 2 / 2
     assert np.allclose(hr.rms_mps2[0] ** 2, ms, rtol=1e-13)
     assert dumps(hr.to_dict()) and hr.to_xarray().rms_mps2.shape == (1, 3)
+    assert hr.plot("lab").axes
 
 
 # ------------------------------------------------------------------------- spectra
@@ -451,3 +452,13 @@ def test_result_objects(ritz):
     assert (
         fr.plot().axes and dumps(fr.to_dict()) and fr.to_xarray().dims == ("point", "axis", "freq")
     )
+
+
+def test_truncated_modes_are_flagged(ritz):
+    """Bands far above the highest kept mode: the modal sum misses the modes above, say so."""
+    _, m = ritz
+    spec = fq.ForcePSD([1.0, 200.0], [1.0, 1.0])
+    lo, hi = np.array([1.0, 90.0]), np.array([1.2, 110.0])
+    r = fq.band_response(m, ZETA, ["lab"], [fq.Load("s", "lab", "x", spec)], lo, hi)
+    assert m.freq_hz[-1] < 1.5 * 110.0
+    assert any("modal truncation" in w for w in r.warnings)

@@ -46,8 +46,8 @@ Band integration is converged, not sampled: composite Gauss-Legendre quadrature 
 ``order`` on intervals whose breakpoints are the band edges, every natural frequency ``f_j``
 inside the band and the geometric grading ``f_j +- 3^k gamma_j`` (``gamma_j = zeta_j f_j``, the
 half-power half-width) out to twice the band width, the breakpoints of every spectrum, and the
-band's midpoint.  Convergence is checked, per band, on every mode's ``int |r_j|^2 df`` and every
-spectrum's ``int S df`` (the rule of order ``2 order`` on the same intervals, and the exact
+band's midpoint.  Convergence is checked, per band, on ``int |r_j|^2 df`` of every mode within
+three band widths (the others are smooth there) and on every spectrum's ``int S df`` (the rule of order ``2 order`` on the same intervals, and the exact
 power of the spectrum); a band that fails has its intervals halved (up to
 :data:`MAX_REFINEMENTS` times) and a band that still fails is named in ``warnings``.
 
