@@ -268,8 +268,14 @@ def _elastic_inverse_iteration(
         x = x.reshape(n, -1)
         return x - B @ (MB.T @ x)
 
+    MBt = np.ascontiguousarray(MB.T)
+
     def op(y: np.ndarray) -> np.ndarray:
-        return g_e(y).reshape(np.shape(y))
+        # ARPACK applies OPinv to M x with x M-orthogonal to the rigid span: the load is
+        # self-equilibrated already (B^T M x = 0), so only the output is projected
+        x = np.array(g(np.asarray(y, float).reshape(n, -1)), float).reshape(n, -1)
+        x -= B @ (MBt @ x)
+        return x.reshape(np.shape(y))
 
     opinv = spla.LinearOperator((n, n), matvec=op, matmat=op, dtype=float)
     v0 = g_e(M @ np.random.default_rng(0).standard_normal(n)).ravel()

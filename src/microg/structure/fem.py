@@ -400,9 +400,19 @@ class TreeFlexibility:
         # C is unit lower triangular: no pivoting, no fill (L = C, U = I)
         self._lu = spla.splu(tree.kinematics().tocsc(), permc_spec="NATURAL", diag_pivot_thresh=0.0)
         k = np.asarray(tree.root_stiffness, float)
-        self._root_inv = np.divide(1.0, k, out=np.zeros(6), where=k != 0.0)
-        self._child = 6 * tree.child[:, None] + np.arange(6)
-        self._root = 6 * tree.root + np.arange(6)
+        root_inv = np.divide(1.0, k, out=np.zeros(6), where=k != 0.0)
+        # D^+ as one block-diagonal sparse matrix (a single compiled product per application)
+        child = 6 * tree.child[:, None] + np.arange(6)
+        rows = np.broadcast_to(child[:, :, None], tree.flexibility.shape).ravel()
+        cols = np.broadcast_to(child[:, None, :], tree.flexibility.shape).ravel()
+        root = 6 * tree.root + np.arange(6)
+        self._dplus = sp.csr_matrix(
+            (
+                np.concatenate([tree.flexibility.ravel(), root_inv]),
+                (np.concatenate([rows, root]), np.concatenate([cols, root])),
+            ),
+            shape=(self.n, self.n),
+        )
 
     def __call__(self, y: np.ndarray) -> np.ndarray:
         """``G y`` for ``y`` (n,) or (n, k): N and N m in, m and rad out."""
@@ -410,9 +420,7 @@ class TreeFlexibility:
         one = y.ndim == 1
         yy = y.reshape(self.n, -1)
         z = self._lu.solve(yy, trans="T")  # internal forces carried by each element
-        w = np.zeros_like(z)
-        w[self._child] = np.einsum("eij,ejk->eik", self.tree.flexibility, z[self._child])
-        w[self._root] = self._root_inv[:, None] * z[self._root]
+        w = self._dplus @ z  # each element's deformation under its own load
         x = self._lu.solve(w)  # deformations summed out from the root
         return x.ravel() if one else x
 
