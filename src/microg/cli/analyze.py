@@ -9,14 +9,13 @@ from __future__ import annotations
 
 import shlex
 import sys
-from collections.abc import Iterator
-from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
 import click
 
 from microg.analysis import DEFAULTS
+from microg.cli._errors import flag_errors
 
 __all__ = ["analyze", "flag_errors", "write_outputs"]
 
@@ -39,22 +38,6 @@ FLAGS = {
     "absorber_mu": "--absorber-mu",
     "out": "--out",
 }
-
-
-@contextmanager
-def flag_errors(flags: dict[str, str]) -> Iterator[None]:
-    """Re-raise library InputErrors with the option's name in place of the parameter's."""
-    from microg.errors import InputError
-
-    try:
-        yield
-    except InputError as exc:
-        where = exc.where
-        if where:
-            head, _, rest = where.partition("[")
-            if head in flags:
-                where = flags[head] + (f" ({head}[{rest}" if rest else "")
-        raise type(exc)(exc.what, where=where, fix=exc.fix) from None
 
 
 def _weight_to_mass(text: str) -> str:

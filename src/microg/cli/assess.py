@@ -92,7 +92,7 @@ def assess(
     --json prints the observations contract of `microg analyze`, keyed by sensor name.
     """
     from microg._io import check_writable, dumps
-    from microg.cli.analyze import flag_errors
+    from microg.cli._errors import flag_errors
     from microg.environment.measured import read_measured
 
     ctx = click.get_current_context()

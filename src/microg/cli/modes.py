@@ -131,7 +131,7 @@ def modes(
     """
     import microg
     from microg._io import dumps
-    from microg.cli.analyze import flag_errors
+    from microg.cli._errors import flag_errors
     from microg.errors import InputError
     from microg.structure.discretize import discretize
 

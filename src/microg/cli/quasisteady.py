@@ -184,7 +184,7 @@ def quasi_steady(
     and in LVLH; a map over the structure with the 1 micro-g zone; the verdict against the
     ISS quasi-steady requirement (1 micro-g at internal payload locations, NASA-CR-205357).
     """
-    from microg.cli.analyze import flag_errors
+    from microg.cli._errors import flag_errors
     from microg.environment import quasisteady as qs
     from microg.models.toml import load_station
     from microg.units import parse_quantity
