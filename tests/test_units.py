@@ -17,6 +17,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+import microg.units as units_module
 from microg.errors import InputError
 from microg.units import LIMITS, QUANTITY_FORM, check_limit, parse_quantity, parse_unit
 
@@ -187,13 +188,60 @@ def test_physical_limits() -> None:
 
 
 def test_import_does_not_load_pint() -> None:
-    # issue 8: `import microg.units` must not import pint (0.4 s); the registry is built on
-    # the first quantity parsed
+    # issue 8: `import microg.units` must not import pint (about 1 s with its registry); the
+    # common units come from the built-in table, and pint only for another name
     code = (
         "import sys, microg.units as u; assert 'pint' not in sys.modules; "
-        "u.parse_quantity('1 ft', 'length', where='x'); assert 'pint' in sys.modules"
+        "u.parse_quantity('1.31e9 lbf*ft^2', 'bending_stiffness', where='x'); "
+        "u.parse_quantity('25 slug/ft', 'mass_per_length', where='x'); "
+        "assert 'pint' not in sys.modules; "
+        "u.parse_quantity('1 furlong', 'length', where='x'); assert 'pint' in sys.modules"
     )
     subprocess.run([sys.executable, "-c", code], check=True)
+
+
+@pytest.mark.parametrize("name", sorted(units_module._BUILTIN))
+def test_builtin_units_agree_with_pint(name: str) -> None:
+    # the independent reference for the built-in table is pint itself: the same factor (to
+    # pint's rounding, 1e-15) in every dimension the unit belongs to, 2 pi rules included
+    entry = units_module._BUILTIN[name]
+    for dimension, dims in units_module._DIMENSION_EXPONENTS.items():
+        if dims != entry[1]:
+            continue
+        mine = units_module._builtin_conversion(f"{name}^1", dimension)
+        theirs = units_module._pint_conversion(f"{name}^1", dimension)
+        assert mine is not None
+        assert mine.factor == pytest.approx(theirs.factor, rel=1e-15), dimension
+
+
+@pytest.mark.parametrize(
+    ("unit", "dimension"),
+    [
+        ("lbf*ft^2", "bending_stiffness"),
+        ("slug/ft", "mass_per_length"),
+        ("slug*ft^2", "rotary_inertia"),
+        ("lbf*s/ft", "damping"),
+        ("ft^3/s^2", "gravitational_parameter"),
+        ("kip/in", "stiffness"),
+        ("rad/s", "frequency"),
+        ("1/min", "angular_frequency"),
+        ("kg/lb", "dimensionless"),
+    ],
+)
+def test_builtin_compounds_agree_with_pint(unit: str, dimension: str) -> None:
+    powers = units_module._UnitParser(units_module._tokens(unit)).parse()
+    canonical = units_module._canonical(powers)
+    mine = units_module._builtin_conversion(canonical, dimension)
+    theirs = units_module._pint_conversion(canonical, dimension)
+    assert mine is not None and mine.factor == pytest.approx(theirs.factor, rel=1e-14)
+
+
+@pytest.mark.parametrize("canonical", ["lbf^1", "", "Hz^1", "kg^1*m^-1"])
+def test_builtin_and_pint_refuse_the_same_dimensions(canonical: str) -> None:
+    # "" is a unit whose powers cancel (m/m): dimensionless, not a length
+    for path in (units_module._builtin_conversion, units_module._pint_conversion):
+        with pytest.raises(units_module._WrongDimensionError):
+            path(canonical, "length")
 
 
 def test_parsing_is_fast_and_cached() -> None:

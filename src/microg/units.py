@@ -12,9 +12,11 @@ A quantity is **parsed by a grammar, never evaluated**::
 
 One number, then one unit expression, and nothing else: ``"296 ft 2"``, ``"2,96 ft"``,
 ``"9**9**9 ft"`` and a unit without a number (``"min"``) are errors whose message gives the
-accepted form.  Only the unit *names* are looked up in pint (each once, cached); pint never
-sees the number or any arithmetic.  The pint registry is built on the first lookup, so
-``import microg.units`` does not import pint.
+accepted form.  The common unit names (m, ft, in, km, kg, lb, slug, N, kN, lbf, s, ms, min,
+Hz, rad, ...) come from a built-in table of exact definitions; any other name is looked up
+in pint (each once, cached).  pint never sees the number or any arithmetic, and its
+registry is built on the first name the table lacks, so ``import microg.units`` (and a
+model written in the common units) does not import pint.
 
 Magnitudes: the number must be finite, and so must its value in SI; callers bound each
 field further by its physical limits (``docs/model-format.md``, "Limits").
@@ -313,9 +315,104 @@ def _si_unit(dimension: str) -> Any:
     return reg.Unit(si.replace("^", "**")) if si else reg.dimensionless
 
 
+# The common units, exactly defined (NIST SP 811), so that a model in ft, slug, lbf or SI
+# never needs pint's registry (about 1 s to import and build): name -> (SI factor, exponents
+# of (m, kg, s), radian (an angle), hertz (a cycle rate)).  Any other name goes to pint.  The
+# tests check every entry against pint.
+_L, _M, _T = (1, 0, 0), (0, 1, 0), (0, 0, 1)
+_BUILTIN: dict[str, tuple[float, tuple[int, int, int], bool, bool]] = {
+    "m": (1.0, _L, False, False),
+    "mm": (1e-3, _L, False, False),
+    "cm": (1e-2, _L, False, False),
+    "km": (1e3, _L, False, False),
+    "ft": (FT, _L, False, False),
+    "in": (IN, _L, False, False),
+    "yd": (3 * FT, _L, False, False),
+    "kg": (1.0, _M, False, False),
+    "g": (1e-3, _M, False, False),
+    "t": (1e3, _M, False, False),
+    "lb": (LB, _M, False, False),
+    "slug": (SLUG, _M, False, False),
+    "N": (1.0, (1, 1, -2), False, False),
+    "kN": (1e3, (1, 1, -2), False, False),
+    "MN": (1e6, (1, 1, -2), False, False),
+    "lbf": (LBF, (1, 1, -2), False, False),
+    "kip": (1e3 * LBF, (1, 1, -2), False, False),
+    "s": (1.0, _T, False, False),
+    "ms": (1e-3, _T, False, False),
+    "min": (60.0, _T, False, False),
+    "h": (3600.0, _T, False, False),
+    "Hz": (1.0, (0, 0, -1), False, True),
+    "kHz": (1e3, (0, 0, -1), False, True),
+    "rad": (1.0, (0, 0, 0), True, False),
+    "deg": (math.pi / 180.0, (0, 0, 0), True, False),
+    "rpm": (2.0 * math.pi / 60.0, (0, 0, -1), True, False),
+    "percent": (1e-2, (0, 0, 0), False, False),
+    "%": (1e-2, (0, 0, 0), False, False),
+}
+#: exponents of (m, kg, s) of each dimension
+_DIMENSION_EXPONENTS: dict[str, tuple[int, int, int]] = {
+    "length": _L,
+    "mass": _M,
+    "force": (1, 1, -2),
+    "time": _T,
+    "frequency": (0, 0, -1),
+    "angular_frequency": (0, 0, -1),
+    "stiffness": (0, 1, -2),
+    "bending_stiffness": (3, 1, -2),
+    "torsional_stiffness": (3, 1, -2),
+    "axial_stiffness": (1, 1, -2),
+    "mass_per_length": (-1, 1, 0),
+    "rotary_inertia": (2, 1, 0),
+    "acceleration": (1, 0, -2),
+    "dimensionless": (0, 0, 0),
+    "damping": (0, 1, -1),
+    "gravitational_parameter": (3, 0, -2),
+    "force_per_length": (0, 1, -2),
+}
+
+
+def _builtin_conversion(canonical: str, dimension: str) -> _Conversion | None:
+    """The conversion from the built-in table, or None when a name is not in it."""
+    factor, dims, radian, hertz = 1.0, [0, 0, 0], 0, False
+    for item in canonical.split("*") if canonical else ():
+        name, _, power_text = item.rpartition("^")
+        entry = _BUILTIN.get(name)
+        if entry is None:
+            return None
+        power = int(power_text)
+        factor *= entry[0] ** power
+        dims = [d + power * e for d, e in zip(dims, entry[1], strict=True)]
+        radian += power * entry[2]
+        hertz = hertz or entry[3]
+    nice = dimension.replace("_", " ")
+    if tuple(dims) != _DIMENSION_EXPONENTS[dimension]:
+        article = "an" if nice[0] in "aeiou" else "a"
+        paren = "its unit {unit} is dimensionless" if not any(dims) else "its unit is {unit}"
+        raise _WrongDimensionError(
+            f"is not {article} {nice} ({paren})",
+            f"use a unit of {nice}, e.g. {DIMENSIONS[dimension] or 'a plain number'}",
+        )
+    if dimension == "angular_frequency" and not radian and hertz:
+        factor *= 2.0 * math.pi
+    elif dimension == "frequency" and radian:
+        factor /= 2.0 * math.pi
+    if not math.isfinite(factor) or factor == 0.0:
+        raise _BadQuantityError("has a unit out of range", "use a unit of ordinary size")
+    return _Conversion(factor)
+
+
 @lru_cache(maxsize=4096)
 def _conversion(canonical: str, dimension: str) -> _Conversion:
     """Scale from the unit ``canonical`` (see :func:`_canonical`) to SI ``dimension`` (cached)."""
+    builtin = _builtin_conversion(canonical, dimension)
+    if builtin is not None:
+        return builtin
+    return _pint_conversion(canonical, dimension)
+
+
+def _pint_conversion(canonical: str, dimension: str) -> _Conversion:
+    """The conversion by pint (any unit pint knows)."""
     reg = registry()
     unit: Any = reg.dimensionless
     names: list[str] = []

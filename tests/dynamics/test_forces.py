@@ -6,6 +6,9 @@ interpolation; the magnitudes of /work/shared/reference/domain.md (Klute, KC-135
 
 from __future__ import annotations
 
+import json
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -235,6 +238,7 @@ def test_csv_non_finite_or_huge_value_names_its_line(tmp_path, value):
     assert "line 4" in str(err.value) and "force" in str(err.value)
 
 
+@pytest.mark.slow  # about 8 s, most of it writing the file (run in CI too)
 def test_csv_a_million_rows_vectorised_and_bad_row_found(tmp_path):
     # the 1e6-row reproduction (more than 60 s before); read vectorised (measured: about
     # 1.5 s for 1e6 rows of two columns, see the report).  Checked against numpy's own parse.
@@ -342,3 +346,35 @@ def test_force_history_limits():
         piecewise_linear([0, 1], [0, 1e300])
     with pytest.raises(InputError, match="beyond the limit of 1e\\+07 s"):
         piecewise_linear([0, 1.7e308], [0, 1])
+
+
+def test_csv_value_overflowing_in_si_names_its_line(tmp_path):
+    # 1.7e308 kN is a finite number whose SI value overflows (no RuntimeWarning)
+    p = write(tmp_path, "time [h],fx [kN],fy [kN],fz [kN]\n0,0,0,1.7e308\n1,0,0,0\n")
+    with pytest.raises(InputError, match="line 2: force is beyond the limit"):
+        from_csv(p)
+
+
+_INPUTS = Path(__file__).parents[1] / "data" / "inputs"
+_EXPECTED = json.loads((_INPUTS / "expected.json").read_text())
+
+
+@pytest.mark.parametrize("name", sorted(n for n in _EXPECTED if n.endswith(".csv")))
+def test_reproduction_force_files(name):
+    # small files written from the descriptions of issues 9 and 10 (the message each must give)
+    path = _INPUTS / name
+    if not _EXPECTED[name]:
+        h = parse_force_spec(str(path))
+        assert h.timepts.size >= 3 and np.all(np.isfinite(h.components(np.array([1.0, 0, 0]))))
+        return
+    with pytest.raises(InputError) as err:
+        parse_force_spec(str(path))
+    msg = str(err.value)
+    assert _EXPECTED[name] in msg and "\n" not in msg and "do-not-print" not in msg
+
+
+def test_csv_header_unit_9_pow_9_pow_9(tmp_path):
+    # the header unit "9**9**9 s" hung every quantity reader
+    p = write(tmp_path, "time [9**9**9 s],force [N]\n0,0\n1,1\n")
+    with pytest.raises(InputError, match="line 1: the unit of the time column is not a unit"):
+        from_csv(p)

@@ -225,3 +225,22 @@ def test_model_modules_split_by_concept() -> None:
     assert toml_module.build_station is build.build_station
     for name in ("load_station", "loads_station", "dump_station", "shipped_models"):
         assert name in toml_module.__all__
+
+
+# ------------------------------------------- the reproduction files of tests/data/inputs/
+
+
+INPUTS = Path(__file__).parents[1] / "data" / "inputs"
+EXPECTED = __import__("json").loads((INPUTS / "expected.json").read_text())
+
+
+@pytest.mark.parametrize("name", sorted(n for n in EXPECTED if n.endswith(".toml")))
+def test_reproduction_model_files(name: str) -> None:
+    # small files written from the descriptions of issue 10 (the message each must give)
+    path = INPUTS / name
+    if not EXPECTED[name]:
+        assert load_station(path).name == "small-si"  # a valid input (BOM)
+        return
+    with pytest.raises(ModelError) as exc:
+        load_station(path)
+    assert EXPECTED[name] in str(exc.value) and "\n" not in str(exc.value)

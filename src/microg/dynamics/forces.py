@@ -337,7 +337,9 @@ _HEADER_CELL = re.compile(
 )
 _BLANK_LINE = re.compile(r"(?:^|\n)[ \t\r]*(?:\n|$)")
 _NUMBER_CHARS = str.maketrans("", "", "0123456789eE+-. \t")
-_STRICT_NUMBER = re.compile(r"^\s*[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?\s*$")
+_STRICT_NUMBER = re.compile(
+    r"^[ \t]*[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?[ \t]*$"
+)
 
 
 def _decode(data: bytes, where: str) -> str:
@@ -447,16 +449,19 @@ def _scale(unit: str, dimension: str, key: str, where: str) -> float:
 
 
 def _column(cells: list[str], key: str, linenos: np.ndarray, where: str) -> np.ndarray:
-    """The floats of one column; the first bad cell is reported by its line, not its text."""
-    bad: int | None = None
-    if "".join(cells).translate(_NUMBER_CHARS):  # a character no plain number has
-        bad = next(i for i, c in enumerate(cells) if not _STRICT_NUMBER.match(c))
-    else:
+    """The floats of one column; the first bad cell is reported by its line, not its text.
+
+    Cells are plain numbers (sign, digits, point, exponent) with optional spaces or tabs
+    around them: float() alone would also take ``1_0``, ``nan``, non-ASCII digits and
+    non-ASCII spaces.
+    """
+    if not "".join(cells).translate(_NUMBER_CHARS):  # only characters a plain number has
         try:
             return np.array(cells, dtype=float)
         except ValueError:
-            bad = next(i for i, c in enumerate(cells) if not _STRICT_NUMBER.match(c))
-    cell = cells[bad].strip()
+            pass
+    bad = next((i for i, c in enumerate(cells) if not _STRICT_NUMBER.match(c)), 0)
+    cell = cells[bad].strip(" \t")
     what = "is empty" if not cell else "is not a number"
     if cell.lower().lstrip("+-") in ("nan", "inf", "infinity"):
         what = "is not a finite number"
@@ -493,7 +498,7 @@ def from_csv(path: str | Path, *, name: str | None = None) -> ForceHistory:
     where = str(path)
     label = name or path.name
     text = _read_text(path, where)
-    lines = text.replace("\r\n", "\n").split("\n")
+    lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")  # any line ending
     if max(map(len, lines)) > MAX_CSV_LINE:
         longest = next(i for i, line in enumerate(lines) if len(line) > MAX_CSV_LINE)
         raise InputError(
@@ -559,10 +564,11 @@ def from_csv(path: str | Path, *, name: str | None = None) -> ForceHistory:
             i = columns[key]
             return [c[i] if i < len(c) else "" for c in table]
 
-    times = _column(col("time"), "time", linenos, where) * t_scale
-    values = np.array(
-        [_column(col(k), k, linenos, where) * s for k, s in zip(fkeys, f_scales, strict=True)]
-    )
+    with np.errstate(over="ignore"):  # a value that overflows in SI is caught just below
+        times = _column(col("time"), "time", linenos, where) * t_scale
+        values = np.array(
+            [_column(col(k), k, linenos, where) * s for k, s in zip(fkeys, f_scales, strict=True)]
+        )
     for arr, key, limit, unit in (
         (times[None, :], "time", LIMITS["time"], "s"),
         (values, "force", LIMITS["force"], "N"),
@@ -690,6 +696,8 @@ _PARAMS_FIX = (
 
 def _parse_params(text: str, where: str) -> dict[str, float]:
     params: dict[str, float] = {}
+    if not text.strip():  # "crew-pushoff:" is the spec without parameters
+        return params
     if re.search(r"[0-9],[0-9]", text):  # t1=1,5s: a decimal comma, not two parameters
         raise InputError(
             "a comma between digits (a decimal comma?)",
