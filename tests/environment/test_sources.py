@@ -120,7 +120,7 @@ BAD = [
     (
         _one('bands = { center_hz = [1.0, 1.25], rms = [1, 1], unit = "kg" }'),
         "bad.toml: source[0].bands.unit",
-        "not a unit of N",
+        "not a unit of force",
     ),
     (
         _one('bands = { center_hz = [1.25, 1.0], rms = [1, 1], unit = "N" }'),
@@ -289,3 +289,15 @@ def test_source_in_python_and_its_load():
     assert s.to_dict()["bands"]["rms_n"] == [0.1, 0.2]
     with pytest.raises(InputError, match="duty"):
         Source("x", "lab", "y", BandLevels([1.0], [0.1]), duty=0.0)
+
+
+def test_reading_a_catalogue_does_not_load_pint():
+    """Units come from microg.units' built-in table (issue 8): no pint registry at startup."""
+    import subprocess
+    import sys
+
+    code = (
+        "import sys; from microg.environment.sources import example_sources; "
+        "example_sources(); assert 'pint' not in sys.modules"
+    )
+    subprocess.run([sys.executable, "-c", code], check=True)

@@ -61,7 +61,7 @@ from microg.dynamics.frequency import (
 )
 from microg.environment.requirements import BandTable
 from microg.errors import InputError
-from microg.units import parse_quantity, ureg
+from microg.units import parse_quantity, parse_unit
 
 __all__ = [
     "MAX_SOURCES",
@@ -104,6 +104,8 @@ _SOURCE_KEYS = {
 _SPECTRUM_KEYS = ("harmonic", "bands", "psd")
 _STATES = ("on", "off")
 _EXAMPLE = "example_sources.toml"
+#: a force-PSD unit: force unit, power 2, "/", frequency unit (``N^2/Hz``, ``(lbf)**2 / Hz``)
+_PSD_UNIT = re.compile(r"^\s*\(?\s*([^()^*/\s]+)\s*\)?\s*(?:\^|\*\*)\s*2\s*/\s*([^()^*/\s]+)\s*$")
 _TOML_POS = re.compile(r"\s*\(at line (\d+), column (\d+)\)")
 
 
@@ -429,18 +431,32 @@ class _Reader:
             out[i] = float(v)
         return out
 
-    def unit_factor(self, unit: Any, target: str, path: str, example: str) -> float:
+    def force_unit(self, unit: Any, path: str) -> float:
+        """SI factor of a force unit (``N``, ``lbf``, ``kN``)."""
         if not isinstance(unit, str) or not unit.strip():
-            raise self.err(
-                path, "is missing", f'give the unit of the values, e.g. unit = "{example}"'
-            )
+            raise self.err(path, "is missing", 'give the unit of the values, e.g. unit = "N"')
         try:
-            q = ureg.Quantity(1.0, unit.strip())
-            return float(q.to(target).magnitude)
-        except Exception:  # pint raises several kinds for unknown or incompatible units
+            return parse_unit(unit.strip(), "force", where=f"{self.file}: {path}")
+        except InputError as exc:
             raise self.err(
-                path, f"{unit!r} is not a unit of {target}", f'use e.g. "{example}"'
+                path, f"{unit!r} is not a unit of force: {exc.what}", 'use e.g. "N" or "lbf"'
             ) from None
+
+    def psd_unit(self, unit: Any, path: str) -> float:
+        """SI factor (to N^2/Hz) of a force-PSD unit ``F^2/f``: ``N^2/Hz``, ``lbf^2/Hz``."""
+        fix = 'write a force squared per frequency, e.g. "N^2/Hz" or "lbf^2/Hz"'
+        if not isinstance(unit, str) or not unit.strip():
+            raise self.err(path, "is missing", f"give the unit of the values: {fix}")
+        m = _PSD_UNIT.match(unit)
+        if not m:
+            raise self.err(path, f"{unit!r} is not a unit of force^2/frequency", fix)
+        where = f"{self.file}: {path}"
+        try:
+            force = parse_unit(m.group(1), "force", where=where)
+            freq = parse_unit(m.group(2), "frequency", where=where)
+        except InputError as exc:
+            raise self.err(path, f"{unit!r}: {exc.what}", fix) from None
+        return force * force / freq
 
     def frequencies(self, f: np.ndarray, path: str) -> None:
         bad = np.flatnonzero(~((f > 0) & (f <= MAX_FREQ_HZ)))
@@ -522,7 +538,7 @@ class _Reader:
                 raise self.err(f"{path}.{key}", "is missing", "give a list of numbers")
         c = self.numbers(raw["center_hz"], f"{path}.center_hz")
         r = self.numbers(raw["rms"], f"{path}.rms")
-        scale = self.unit_factor(raw.get("unit"), "N", f"{path}.unit", "N")
+        scale = self.force_unit(raw.get("unit"), f"{path}.unit")
         if c.size != r.size:
             raise self.err(
                 f"{path}.rms",
@@ -573,7 +589,7 @@ class _Reader:
                 raise self.err(f"{path}.{key}", "is missing", "give a list of numbers")
         f = self.numbers(raw["frequency_hz"], f"{path}.frequency_hz")
         v = self.numbers(raw["value"], f"{path}.value")
-        scale = self.unit_factor(raw.get("unit"), "N**2/Hz", f"{path}.unit", "N^2/Hz")
+        scale = self.psd_unit(raw.get("unit"), f"{path}.unit")
         if f.size != v.size:
             raise self.err(
                 f"{path}.value",
