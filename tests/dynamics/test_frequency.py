@@ -462,3 +462,20 @@ def test_truncated_modes_are_flagged(ritz):
     r = fq.band_response(m, ZETA, ["lab"], [fq.Load("s", "lab", "x", spec)], lo, hi)
     assert m.freq_hz[-1] < 1.5 * 110.0
     assert any("modal truncation" in w for w in r.warnings)
+
+
+def test_unstable_modes_are_flagged():
+    """A gravity-gradient-unstable attitude has no steady state: the result says so."""
+    from pathlib import Path
+
+    from microg.structure.discretize import discretize
+
+    path = Path(__file__).parents[1] / "data" / "models" / "solver_unstable.toml"
+    s = discretize(load_station(path), "ritz", plane="yz", gravity_gradient=True)
+    m = solve_modes(s)
+    assert np.any(m.unstable)
+    spec = fq.ForcePSD([0.01, 1.0], [1.0, 1.0])
+    r = fq.band_response(
+        m, ZETA, ["lab"], [fq.Load("s", "lab", "y", spec)], np.array([0.01]), np.array([0.02])
+    )
+    assert any("unstable mode" in w for w in r.warnings)

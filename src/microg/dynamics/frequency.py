@@ -47,9 +47,10 @@ Band integration is converged, not sampled: composite Gauss-Legendre quadrature 
 inside the band and the geometric grading ``f_j +- 3^k gamma_j`` (``gamma_j = zeta_j f_j``, the
 half-power half-width) out to twice the band width, the breakpoints of every spectrum, and the
 band's midpoint.  Convergence is checked, per band, on ``int |r_j|^2 df`` of every mode within
-three band widths (the others are smooth there) and on every spectrum's ``int S df`` (the rule of order ``2 order`` on the same intervals, and the exact
-power of the spectrum); a band that fails has its intervals halved (up to
-:data:`MAX_REFINEMENTS` times) and a band that still fails is named in ``warnings``.
+three band widths (the others are smooth there) and on every spectrum's ``int S df``: the rule
+of order ``2 order`` on the same intervals, and the exact power of the spectrum; a band that
+fails has its intervals halved (up to :data:`MAX_REFINEMENTS` times) and a band that still fails
+is named in ``warnings``.
 
 Each band's response is summed in amplitude at the nodes (never from squared sums, so a
 response that is small by cancellation between modes keeps its relative accuracy): the modes
@@ -1553,6 +1554,17 @@ def band_response(
         contributions=contributions,
     )
     warnings = list(arr.warnings)
+    uns = getattr(modes, "unstable", None)
+    unstable = np.zeros(modes.n_modes, bool) if uns is None else np.asarray(uns, bool)
+    if unstable.any():
+        rate = getattr(modes, "growth_rate", None)
+        g = np.zeros(modes.n_modes) if rate is None else np.asarray(rate, float)
+        g = g[unstable]
+        warnings.append(
+            f"{int(unstable.sum())} unstable mode(s) (growth rate up to {g.max():.3g} rad/s): "
+            "no steady state exists; their terms are taken as the mass line, which is off by "
+            f"(growth rate / w)^2, {(g.max() / (2 * np.pi * lo.min())) ** 2:.1e} at the lowest band"
+        )
     fm = modes.freq_hz
     elastic = fm[~np.asarray(modes.rigid, bool)]
     top_band = float(hi[np.any(arr.total > 0, axis=0)].max(initial=0.0))
