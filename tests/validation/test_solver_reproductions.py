@@ -208,7 +208,9 @@ def test_chain_of_300_beams_is_one_straight_beam():
     )
     ref = solve_modes(build_fem(one, elements_per_beam=3000), 16)
     assert m.n_rigid == 6
-    np.testing.assert_allclose(m.omega[6:], ref.omega[6:], rtol=1e-9)
+    # the two meshes place their nodes by different sums (0.5 i against s / 3000), so the
+    # models differ by rounding; ARPACK's Ritz values of the 10th mode then agree to ~2e-9
+    np.testing.assert_allclose(m.omega[6:], ref.omega[6:], rtol=1e-8)
     with pytest.raises(InputError, match="at most 40 beams"):
         build_ritz(st, None, 1)  # the assumed-modes limit, documented in ritz.MAX_RITZ_BEAMS
 
