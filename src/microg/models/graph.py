@@ -30,14 +30,11 @@ import tomllib
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
 from microg.errors import InputError, ModelError
-
-if TYPE_CHECKING:
-    from microg.structure.structure import Structure
 
 __all__ = [
     "BASIC",
@@ -510,12 +507,6 @@ class GraphModel:
             raise InputError(f"unknown node {name!r}", fix=_nearest(name, list(idx)))
         return self.nodes[idx[name]]
 
-    def to_structure(self, **options: Any) -> Structure:
-        """The free-free Structure of the model: :func:`microg.structure.frame.build_frame`."""
-        from microg.structure.frame import build_frame  # the structure stage, on demand
-
-        return build_frame(self, **options)
-
 
 def _nearest(name: str, known: Sequence[str], n: int = 5) -> str:
     """'nearest names: ...' for an error message (numeric distance for grid:N names)."""
@@ -599,10 +590,14 @@ def validate_graph(graph: GraphModel) -> None:
         bad = graph.nodes[int(np.flatnonzero(~np.isfinite(pos).all(axis=1))[0])].name
         raise InputError("position is not finite", where=f"{src}: {bad}")
     scale = max(float(np.ptp(pos, axis=0).max()) if pos.shape[0] > 1 else 0.0, 1e-300)
-    for n in graph.nodes:
-        ax = np.asarray(n.axes, float)
-        if ax.shape != (3, 3) or not np.allclose(ax @ ax.T, np.eye(3), atol=1e-9):
-            raise InputError("axes are not orthonormal", where=f"{src}: {n.name}")
+    try:
+        axes = np.array([n.axes for n in graph.nodes], float).reshape(-1, 3, 3)
+    except ValueError:
+        axes = np.full((len(graph.nodes), 3, 3), np.nan)
+    err = np.abs(axes @ np.swapaxes(axes, 1, 2) - np.eye(3)).max(axis=(1, 2))
+    if not np.all(err <= 1e-9):
+        bad = graph.nodes[int(np.flatnonzero(~(err <= 1e-9))[0])].name
+        raise InputError("axes are not orthonormal", where=f"{src}: {bad}")
 
     def ref(node: str | None, where: str) -> None:
         if node is not None and node not in index:
@@ -612,59 +607,43 @@ def validate_graph(graph: GraphModel) -> None:
                 fix=_nearest(node, list(index)),
             )
 
+    checked: set[int] = set()
     for b in graph.beams:
         for nd in b.nodes:
             ref(nd, b.name)
         s = b.section
-        vals = (s.ea_N, s.ei_y_N_m2, s.ei_z_N_m2, s.gj_N_m2)
-        if not all(math.isfinite(v) and v > 0 for v in vals):
-            raise InputError(
-                f"section {s.name!r} needs EA, EI_y, EI_z, GJ > 0, got {vals}",
-                where=f"{src}: {b.name}",
-                fix="give positive stiffnesses (E, G and the section's A, I1, I2, J)",
-            )
-        if s.ei_yz_N_m2 and s.ei_y_N_m2 * s.ei_z_N_m2 <= s.ei_yz_N_m2**2:
-            raise InputError(
-                f"section {s.name!r}: I1 I2 must exceed I12^2",
-                where=f"{src}: {b.name}",
-            )
-        for v, what in (
-            (s.mass_per_length_kg_per_m, "mass per length"),
-            (s.polar_mass_kg_m, "polar mass moment"),
-            (s.rotary_y_kg_m, "rotary inertia"),
-            (s.rotary_z_kg_m, "rotary inertia"),
-        ):
-            if not (math.isfinite(v) and v >= 0):
-                raise InputError(f"section {s.name!r}: negative {what}", where=f"{src}: {b.name}")
-        for sv in (s.shear_y_N, s.shear_z_N):
-            if sv is not None and not (math.isfinite(sv) and sv > 0):
-                raise InputError(
-                    f"section {s.name!r}: shear stiffness must be > 0 (or absent)",
-                    where=f"{src}: {b.name}",
-                )
+        if id(s) not in checked:
+            _check_section(s, f"{src}: {b.name}")
+            checked.add(id(s))
         if b.kind not in ("beam", "bar"):
             raise InputError(f"unknown beam kind {b.kind!r}", where=f"{src}: {b.name}")
-        off = np.asarray(b.offsets, float).reshape(2, 3)
-        ends = pos[[index[b.nodes[0]], index[b.nodes[1]]]] + off
-        axis = ends[1] - ends[0]
-        length = float(np.linalg.norm(axis))
-        if length <= ZERO_LENGTH_TOL * scale:
-            raise InputError(
-                "has zero length (its ends coincide)",
-                where=f"{src}: {b.name}",
-                fix="connect two distinct points, or use a spring (CBUSH) or rigid link (RBE2)",
-            )
-        ov = np.asarray(b.orientation, float)
-        nv = float(np.linalg.norm(ov))
-        if not nv > 0 or np.linalg.norm(np.cross(axis / length, ov / nv)) <= PARALLEL_TOL:
-            raise InputError(
-                "orientation vector is zero or parallel to the beam",
-                where=f"{src}: {b.name}",
-                fix="give a vector in the beam's x-y plane, not along its axis",
-            )
         for rel in b.releases:
             if rel:
                 parse_components(rel, where=f"{src}: {b.name}: releases")
+    if graph.beams:
+        ia = np.array([index[b.nodes[0]] for b in graph.beams])
+        ib = np.array([index[b.nodes[1]] for b in graph.beams])
+        off = np.array([b.offsets for b in graph.beams], float).reshape(-1, 2, 3)
+        axis = (pos[ib] + off[:, 1]) - (pos[ia] + off[:, 0])
+        length = np.linalg.norm(axis, axis=1)
+        short = np.flatnonzero(~(length > ZERO_LENGTH_TOL * scale))
+        if short.size:
+            raise InputError(
+                "has zero length (its ends coincide)",
+                where=f"{src}: {graph.beams[int(short[0])].name}",
+                fix="connect two distinct points, or use a spring (CBUSH) or rigid link (RBE2)",
+            )
+        ov = np.array([b.orientation for b in graph.beams], float).reshape(-1, 3)
+        nv = np.linalg.norm(ov, axis=1)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            sine = np.linalg.norm(np.cross(axis / length[:, None], ov / nv[:, None]), axis=1)
+        para = np.flatnonzero(~(sine > PARALLEL_TOL))
+        if para.size:
+            raise InputError(
+                "orientation vector is zero or parallel to the beam",
+                where=f"{src}: {graph.beams[int(para[0])].name}",
+                fix="give a vector in the beam's x-y plane, not along its axis",
+            )
     for r in graph.rods:
         for nd in r.nodes:
             ref(nd, r.name)
@@ -745,6 +724,31 @@ def validate_graph(graph: GraphModel) -> None:
     for c in graph.constraints:
         ref(c.node, f"constraint on {c.node}")
         parse_components(c.components, where=f"{src}: constraint on {c.node}")
+
+
+def _check_section(s: BeamSection, where: str) -> None:
+    vals = (s.ea_N, s.ei_y_N_m2, s.ei_z_N_m2, s.gj_N_m2)
+    if not all(math.isfinite(v) and v > 0 for v in vals):
+        raise InputError(
+            f"section {s.name!r} needs EA, EI_y, EI_z, GJ > 0, got {vals}",
+            where=where,
+            fix="give positive stiffnesses (E, G and the section's A, I1, I2, J)",
+        )
+    if s.ei_yz_N_m2 and s.ei_y_N_m2 * s.ei_z_N_m2 <= s.ei_yz_N_m2**2:
+        raise InputError(f"section {s.name!r}: I1 I2 must exceed I12^2", where=where)
+    for v, what in (
+        (s.mass_per_length_kg_per_m, "mass per length"),
+        (s.polar_mass_kg_m, "polar mass moment"),
+        (s.rotary_y_kg_m, "rotary inertia"),
+        (s.rotary_z_kg_m, "rotary inertia"),
+    ):
+        if not (math.isfinite(v) and v >= 0):
+            raise InputError(f"section {s.name!r}: negative {what}", where=where)
+    for sv in (s.shear_y_N, s.shear_z_N):
+        if sv is not None and not (math.isfinite(sv) and sv > 0):
+            raise InputError(
+                f"section {s.name!r}: shear stiffness must be > 0 (or absent)", where=where
+            )
 
 
 # --------------------------------------------------------------------------- graph TOML

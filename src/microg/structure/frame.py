@@ -56,8 +56,9 @@ Degrees of freedom:
    condensed stiffness is dense: at most :data:`CONDENSE_MAX` retained DOFs (a documented
    limit: a larger lumped model needs ``mass="consistent"``, or a solver that accepts a
    singular mass matrix).
-3. **Rigid-body vectors** are the exact unit translations and rotations about the origin,
-   restricted to the retained DOFs (a rigid motion satisfies every link exactly).
+3. **Rigid-body vectors** are the exact unit translations and rotations about the centre of
+   mass (as :mod:`microg.structure.fem`'s), restricted to the retained DOFs (a rigid motion
+   satisfies every link exactly).
 
 The structure is free-free; ``constrained=True`` applies the model's single-point
 constraints (NASTRAN SPC) instead, for validation against clamped decks.
@@ -281,7 +282,11 @@ def beam_mass_consistent_local(
     rz = zero if rotary_z is None else np.asarray(rotary_z, float)
     for idx, phi, rot, s in (((1, 5, 7, 11), pv, rz, 1.0), ((2, 4, 8, 10), pw, ry, -1.0)):
         ix = np.asarray(idx)
-        out[:, ix[:, None], ix[None, :]] = _plane_mass(L, m, rot, phi, s)
+        e = np.flatnonzero((phi != 0) | (rot != 0))  # the others are the fem kernel's exactly
+        if e.size:
+            out[e[:, None, None], ix[None, :, None], ix[None, None, :]] = _plane_mass(
+                L[e], m[e], rot[e], phi[e], s
+            )
     return out
 
 
@@ -1080,18 +1085,19 @@ def build_frame(
         G_out = Gn[retained][:, retained].tocsr()
     labels = tuple(ind_labels[i] for i in retained)
 
-    # rigid-body vectors: exact unit motions about the origin, restricted (n_ind -> retained)
+    # mass properties from the unconstrained mass and the exact rigid vectors about the origin
     P = fm.positions
-    rg = rigid_link(P).reshape(-1, 6)  # g-set rows, columns x y z rx ry rz
-    r_ind = rg[fm.independent]
+    r_origin = rigid_link(P).reshape(-1, 6)[fm.independent]  # columns x y z rx ry rz
+    total, cm, inertia = _mass_props(fm.transform.T @ fm.mass @ fm.transform, r_origin)
+    # rigid-body vectors: exact unit motions about the centre of mass (lever arms formed once,
+    # as microg.structure.fem does), restricted to the retained coordinates
+    r_ind = rigid_link(P - cm).reshape(-1, 6)[fm.independent]
     r_ret = (r_ind if Q is None else np.asarray(Q.T @ r_ind))[retained]
     rigid = (
         {}
         if constrained and applied
         else {d: r_ret[:, k].copy() for k, d in enumerate(("x", "y", "z", "rx", "ry", "rz"))}
     )
-    # mass properties from the unconstrained mass and the exact rigid vectors
-    total, cm, inertia = _mass_props(fm.transform.T @ fm.mass @ fm.transform, r_ind)
 
     samples = _samples(graph, fm.positions, fm.names, T, retained, massless, X, n_ind)
 
