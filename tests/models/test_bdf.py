@@ -396,12 +396,6 @@ def test_cli_exit_status_two_for_a_bad_deck(tmp_path, capsys):
     if importlib.util.find_spec("microg.models.load") is None:
         pytest.skip("microg.models.load (the loader that dispatches .bdf) is not in the tree yet")
     from microg.cli import main
-    from microg.structure.discretize import discretize
-
-    try:
-        discretize(load_bdf(_deck(tmp_path, BASE + "CONM2,5,2,,1.\n", "d.bdf"), units="m, N, s"))
-    except (AttributeError, TypeError, InputError):
-        pytest.skip("microg.discretize does not dispatch graph models yet (the lead's change)")
 
     deck = _deck(tmp_path, BASE + "CQUAD4,5,20,1,2,2,1\n")
     assert main(["modes", str(deck), "--units", "m, N, s"]) == 2
@@ -409,6 +403,18 @@ def test_cli_exit_status_two_for_a_bad_deck(tmp_path, capsys):
     assert "\n" not in err and "unsupported cards: CQUAD4 (1)" in err
     assert main(["modes", str(_deck(tmp_path, BASE, "ok.bdf"))]) == 2
     assert "units" in capsys.readouterr().err
+    bad = {
+        "prop.bdf": (BASE.replace("CBAR,1,10", "CBAR,1,11"), "CBAR 1: property 11"),
+        "zero.bdf": (BASE.replace("GRID,2,,1.,0.,0.", "GRID,2,,0.,0.,0."), "zero length"),
+        "bush.bdf": (
+            "GRID,1,,0.,0.,0.\nGRID,2,,1.,0.,0.\nPBUSH,5,K,1.,2.,3.\nCBUSH,1,5,1,2\n",
+            "CBUSH 1",
+        ),
+    }
+    for name, (text, part) in bad.items():
+        assert main(["modes", str(_deck(tmp_path, text, name)), "--units", "in,lbf,s"]) == 2
+        err = capsys.readouterr().err.strip()
+        assert "\n" not in err and name in err and part in err, err
 
 
 def test_structure_of_a_deck_solves(tmp_path):
