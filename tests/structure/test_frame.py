@@ -637,3 +637,24 @@ def test_discretize_of_a_graph_and_partial_components_need_basic_axes():
         assemble_frame(bad)
     ok = GraphModel("x", nodes, masses=masses, rigid_links=(RigidLink("l", "m", ("r",), "123"),))
     assert assemble_frame(ok).transform.shape == (12, 9)
+
+
+def test_acceleration_map_runs_on_a_graph_structure():
+    # the samples follow microg.structure.fem.NodeSamples' interface (position, labels,
+    # component, displacement): the location stage's acceleration map uses them unchanged
+    from microg.dynamics.forces import crew_pushoff
+    from microg.location.amap import acceleration_map
+
+    g = _truss_loop("lumped")
+    s = build_frame(g)
+    modes = solve_modes(s)
+    rigid = modes.subset(np.flatnonzero(modes.rigid))
+    amap = acceleration_map(s, rigid, "crew", "x", crew_pushoff())
+    assert amap.n_samples >= len(s.samples)  # the map may add samples along rigid lines
+    assert np.all(np.isfinite(amap.measure())) and amap.measure().max() > 0
+
+
+def test_condensation_limit_is_an_input_error():
+    with pytest.raises(InputError, match="beyond the limit of 5") as exc:
+        build_frame(_truss_loop("lumped"), condense_max=5)
+    assert "consistent" in str(exc.value)
