@@ -658,3 +658,24 @@ def test_condensation_limit_is_an_input_error():
     with pytest.raises(InputError, match="beyond the limit of 5") as exc:
         build_frame(_truss_loop("lumped"), condense_max=5)
     assert "consistent" in str(exc.value)
+
+
+def test_station_graph_gives_build_fem_acceleration_map():
+    # the converted IOC has build_fem's samples (same labels and carriers) and acceleration
+    # map: agreement to 1e-6 of the peak (the two solvers' frequencies differ by ~1e-9, and
+    # the map's time grid follows them)
+    from microg.dynamics.forces import crew_pushoff
+    from microg.location.amap import acceleration_map
+
+    station = load_station("ioc")
+    s_fem = build_fem(station, elements_per_beam=6)
+    s_fr = build_frame(graph_from_station(station, elements_per_beam=6))
+    assert s_fr.samples.labels == s_fem.samples.labels
+    point = station.points[0].name
+    maps = [
+        acceleration_map(s, solve_modes(s, 30), point, "x", crew_pushoff()) for s in (s_fem, s_fr)
+    ]
+    assert maps[0].n_samples == maps[1].n_samples
+    np.testing.assert_allclose(
+        maps[1].measure(), maps[0].measure(), rtol=0, atol=1e-6 * maps[0].measure().max()
+    )

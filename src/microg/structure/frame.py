@@ -528,7 +528,8 @@ class FrameSamples:
     labels : tuple of str
         ``"grid:7"``, ``"grid:11/conm2:21"``.
     component : ndarray (p,) of str
-        Carrier of each sample (its node), for the acceleration maps.
+        Carrier of each sample for the acceleration maps: the label's prefix (``"keel"`` of
+        ``"keel:n3"``, ``"grid"`` of ``"grid:7"``), as the maps read frame labels.
     offset : ndarray (p, 3)
         Sample position minus node position, m.
     rows : sparse CSR (6 p, n_ind)
@@ -1278,15 +1279,18 @@ def _samples(
     nodes = [int(i) for i in np.flatnonzero(reach)]
     offs = [np.zeros(3)] * len(nodes)
     labels = [names[i] for i in nodes]
-    comp = list(labels)
     index = graph.node_index()
     for m in graph.masses:
         if np.any(m.offset_m):
             i = index[m.node]
             nodes.append(i)
             offs.append(np.asarray(m.offset_m, float))
-            labels.append(f"{m.node}/{m.name}")
-            comp.append(m.node)
+            # a station's body masses are named "body/mass" (graph_from_station): kept as they
+            # are, the labels of microg.structure.fem's samples
+            labels.append(m.name if "/" in m.name else f"{m.node}/{m.name}")
+    # carriers as the acceleration maps read frame labels: "keel:n3" -> "keel" (a station's
+    # beam, whose samples form a line), "core/orbiter" -> "core", "grid:7" -> "grid"
+    comp = [lab.split("/", 1)[0].split(":", 1)[0] for lab in labels]
     nodes_arr = np.asarray(nodes, int)
     offset = np.array(offs, float).reshape(-1, 3)
     sel = (6 * nodes_arr[:, None] + np.arange(6)).ravel()
