@@ -70,6 +70,8 @@ MAX_SAMPLES = 2_000_000
 REQUIREMENT_INTERVAL_S = 100.0
 #: modes solved for sparse (frame) models when ``n_modes`` is not given
 DEFAULT_SPARSE_MODES = 60
+#: ... and when vibratory sources are assessed (their bands reach 300 Hz)
+DEFAULT_SOURCE_MODES = 300
 #: the defaults of :func:`analyze` and ``microg analyze``, SI
 DEFAULTS: dict[str, Any] = {
     "force": "crew-pushoff",
@@ -148,6 +150,9 @@ class AnalysisOptions:
         Advise isolation where a point does not comply.
     gravity_gradient : bool
         Restrain the rigid rotations by the gravity-gradient (libration) stiffness.
+    sources : SourceCatalogue or None
+        Continuous vibratory sources, assessed in the frequency domain beside (or, with no
+        disturbance, instead of) the transient response.
     """
 
     disturbances: Sequence[Disturbance]
@@ -165,6 +170,7 @@ class AnalysisOptions:
     absorber_mu: float | None = None
     isolation: bool = True
     gravity_gradient: bool = DEFAULTS["gravity_gradient"]
+    sources: Any = None
 
 
 @dataclass(frozen=True)
@@ -308,6 +314,9 @@ class Analysis:
     notes : list of str
     meta : dict
         Provenance: microg version, UTC time, command, model path and sha256.
+    frequency_domain : VibratoryAssessment or None
+        The vibratory sources' band table per observed point (frequency domain), when sources
+        were given.
     """
 
     model: str
@@ -321,11 +330,15 @@ class Analysis:
     warnings: list[str] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
     meta: dict[str, Any] = field(default_factory=dict)
+    frequency_domain: Any = None
 
     @property
     def complies(self) -> bool:
-        """Every observed point meets the band requirement."""
-        return all(o.complies for o in self.observations.values())
+        """Every observed point meets the band requirement (transient and vibratory)."""
+        ok = all(o.complies for o in self.observations.values())
+        if self.frequency_domain is not None:
+            ok = ok and bool(np.all(self.frequency_domain.complies))
+        return ok
 
     @property
     def responses(self) -> dict[str, PointResponse]:
@@ -365,6 +378,7 @@ class Analysis:
                 "max_freq_hz": o.max_freq_hz,
             },
             "observations": {n: ob.to_dict() for n, ob in self.observations.items()},
+            **self._frequency_dict(),
             "complies": self.complies,
             "report_criterion": {
                 "limit_g": REPORT_LIMIT_G,
@@ -372,10 +386,18 @@ class Analysis:
                     ob.assessment.peak_accel_g <= REPORT_LIMIT_G
                     for ob in self.observations.values()
                 ),
-            },
+            }
+            if self.observations
+            else None,
             "warnings": list(self.warnings),
             "notes": list(self.notes),
         }
+
+    def _frequency_dict(self) -> dict[str, Any]:
+        fd = self.frequency_domain
+        if fd is None:
+            return {}
+        return {"frequency_domain": fd.to_dict(), "frequency_domain_basis": fd.info_dict()}
 
     def plot(self) -> Figure:
         """The modes used and the peak at each observed point (a Figure)."""
@@ -502,6 +524,17 @@ def _load(model: Any) -> Any:
     return model
 
 
+def _sources(sources: Any) -> Any:
+    """A source catalogue from a path, ``"example"`` or a catalogue object (None: none)."""
+    if sources is None:
+        return None
+    if isinstance(sources, str | Path):
+        from microg.environment.sources import load_sources
+
+        return load_sources(sources)
+    return sources
+
+
 def _requirement(name: str | Requirement) -> Requirement:
     if isinstance(name, Requirement):
         return name
@@ -538,6 +571,7 @@ def analyze(
     absorber_mu: float | None = None,
     isolation: bool = True,
     gravity_gradient: bool = DEFAULTS["gravity_gradient"],
+    sources: Any = None,
     progress: Callable[[str], None] | None = None,
     command: str | None = None,
 ) -> Analysis:
@@ -582,6 +616,10 @@ def analyze(
         Advise isolation where a point does not comply.
     gravity_gradient : bool
         Restrain the rigid rotations by gravity gradient (libration).
+    sources : str, Path or SourceCatalogue, optional
+        A source catalogue (``[[source]]`` TOML, see :mod:`microg.environment.sources`, or
+        ``"example"``): continuous vibratory sources assessed in the frequency domain.  With
+        sources and no ``force``, only the frequency-domain analysis runs.
     progress : callable, optional
         Called with a stage name as each stage starts.
     command : str, optional
@@ -598,12 +636,13 @@ def analyze(
     """
     mdl = _load(model)
     units = getattr(mdl, "unit_system", None)
-    forces = _forces(force)
+    catalogue = _sources(sources)
+    forces = [] if (catalogue is not None and force is None) else _forces(force)
     nf = len(forces)
     points = _point_names(mdl)
     known = [p for p, _ in points]
     at_list = [str(a) for a in _as_list(at)]
-    if not at_list:
+    if not at_list and nf:
         crew = [p for p, k in points if k == "crew"]
         if not crew:
             raise InputError(
@@ -615,7 +654,7 @@ def analyze(
         obs = [p for p, k in points if k == "experiment"] or list(known)
     dirs = _directions(direction) or [DEFAULTS["direction"]]
     for name, vals in (("at", at_list), ("direction", dirs)):
-        if len(vals) not in (1, nf):
+        if nf and len(vals) not in (1, nf):
             raise InputError(
                 f"{len(vals)} values for {nf} forces", where=name, fix="give one, or one per force"
             )
@@ -655,6 +694,7 @@ def analyze(
         absorber_mu=absorber_mu,
         isolation=isolation,
         gravity_gradient=gravity_gradient,
+        sources=catalogue,
     )
     return run_analysis(
         mdl,
@@ -682,7 +722,7 @@ def _check_record(opts: AnalysisOptions) -> None:
         )
     if not opts.max_freq_hz > 0:
         raise InputError(f"must be > 0, got {opts.max_freq_hz:g} Hz", where="max_freq")
-    if not opts.disturbances:
+    if not opts.disturbances and opts.sources is None:
         raise InputError("no disturbance", where="force", fix="give at least one force")
     for d in opts.disturbances:
         end = float(d.force.timepts[-1])
@@ -924,15 +964,64 @@ def run_analysis(
     structure = _structure(model, opts)
     for d in opts.disturbances:
         structure.point(d.point)
-    maps = {name: structure.point(name).translation for name in opts.observe}
+    if opts.sources is not None:
+        opts.sources.validate_points(structure.points)
+    for name in opts.observe:
+        structure.point(name)
     step("modes")
     n_req = None
     if structure.is_sparse:
-        n_req = min(structure.n_dof - 1, opts.n_modes or DEFAULT_SPARSE_MODES)
+        # the vibratory regime reaches 300 Hz: sources need the modes well above it
+        default = DEFAULT_SOURCE_MODES if opts.sources is not None else DEFAULT_SPARSE_MODES
+        n_req = min(structure.n_dof - 1, opts.n_modes or default)
     modes = solve_modes(structure, n_req)
     warnings: list[str] = []
     elastic = getattr(modes, "elastic", ~modes.rigid)
     used = modes.rigid | (np.asarray(elastic) & (modes.freq_hz <= opts.max_freq_hz))
+    observations: dict[str, Observation] = {}
+    t = np.zeros(0)
+    if opts.disturbances:
+        observations, t, w = _transient(structure, modes, used, opts, req, step)
+        warnings += w
+    vib = None
+    if opts.sources is not None:
+        step("frequency domain")
+        from microg.environment.vibratory import assess_sources
+
+        zeta_all = np.where(modes.rigid, 0.0, opts.zeta)
+        vib = assess_sources(modes, opts.sources, list(opts.observe), req, zeta_all)
+        warnings += [f"frequency domain: {w}" for w in vib.warnings]
+    for pname, ob in observations.items():
+        warnings += [f"{pname}: {w}" for w in ob.assessment.warnings]
+    notes = _notes(model, opts, observations)
+    name = getattr(model, "name", None) or structure.meta.get("model", "model")
+    return Analysis(
+        model=str(name),
+        options=opts,
+        structure=structure,
+        modes=modes,
+        used=used,
+        observations=observations,
+        timepts=t,
+        requirement=req,
+        warnings=warnings,
+        notes=notes,
+        meta=_meta(model, command),
+        frequency_domain=vib,
+    )
+
+
+def _transient(
+    structure: Structure,
+    modes: Modes,
+    used: np.ndarray,
+    opts: AnalysisOptions,
+    req: Requirement,
+    step: Callable[[str], None],
+) -> tuple[dict[str, Observation], np.ndarray, list[str]]:
+    """The transient regime: exact response, assessment, exact peaks, isolation advice."""
+    warnings: list[str] = []
+    maps = {name: structure.point(name).translation for name in opts.observe}
     if structure.is_sparse and not modes.rigid[-1] and modes.freq_hz[-1] <= opts.max_freq_hz:
         warnings.append(
             f"only {modes.n_modes} modes computed; the highest ({modes.freq_hz[-1]:.3g} Hz) is "
@@ -996,31 +1085,17 @@ def run_analysis(
                 absorber_mu=opts.absorber_mu,
             )
             observations[name] = replace(ob, isolation=adv)
-    for pname, ob in observations.items():
-        warnings += [f"{pname}: {w}" for w in ob.assessment.warnings]
-    notes = _notes(model, opts, observations)
-    name = getattr(model, "name", None) or structure.meta.get("model", "model")
-    return Analysis(
-        model=str(name),
-        options=opts,
-        structure=structure,
-        modes=modes,
-        used=used,
-        observations=observations,
-        timepts=t,
-        requirement=req,
-        warnings=warnings,
-        notes=notes,
-        meta=_meta(model, command),
-    )
+    return observations, t, warnings
 
 
 def _notes(model: Any, opts: AnalysisOptions, obs: Mapping[str, Observation]) -> list[str]:
-    notes = [
-        f"the band verdict is judged on the band RMS over the whole {opts.duration_s:g}-s "
-        f"record: a choice (a transient's band RMS falls as the record grows); the margin over "
-        f"the worst {REQUIREMENT_INTERVAL_S:g}-s interval is given beside it"
-    ]
+    notes = []
+    if obs:
+        notes.append(
+            f"the band verdict is judged on the band RMS over the whole {opts.duration_s:g}-s "
+            f"record: a choice (a transient's band RMS falls as the record grows); the margin "
+            f"over the worst {REQUIREMENT_INTERVAL_S:g}-s interval is given beside it"
+        )
     masses = getattr(model, "all_masses", None)
     fitted = [pm.name for pm in masses() if pm.fitted] if callable(masses) else []
     if fitted:

@@ -36,6 +36,7 @@ FLAGS = {
     "requirement": "--requirement",
     "package_mass": "--package-mass/--package-weight",
     "absorber_mu": "--absorber-mu",
+    "sources": "--sources",
     "out": "--out",
 }
 
@@ -164,6 +165,13 @@ def _weight_to_mass(text: str) -> str:
     help="Add a vibration absorber of this mass ratio to the report-rule mount.",
 )
 @click.option(
+    "--sources",
+    default=None,
+    help="Source catalogue (TOML [[source]] tables; 'example' for the shipped illustrative one): "
+    "continuous vibratory sources judged in the frequency domain, beside the transient "
+    "analysis, or instead of it when no --force is given.",
+)
+@click.option(
     "--out",
     "out_dir",
     type=click.Path(file_okay=False, path_type=Path),
@@ -191,6 +199,7 @@ def analyze(
     package_mass: str | None,
     package_weight: str | None,
     absorber_mu: float | None,
+    sources: str | None,
     out_dir: Path,
     as_json: bool,
     no_progress: bool,
@@ -241,6 +250,7 @@ def analyze(
         result = microg.analyze(
             model,
             force=list(forces) or None,
+            sources=sources,
             at=list(at_points) or None,
             direction=list(directions) or None,
             observe=list(observe) or None,
@@ -308,6 +318,19 @@ def summary(result: Any, path: Path) -> None:
             f"RMS {a.rms_accel_g:.3g} g, {verdict} with {a.requirement}"
         )
         click.echo(f"    isolation: {ob.isolation.note}")
+    fd = result.frequency_domain
+    if fd is not None:
+        click.echo(f"  frequency domain ({len(fd.sources)} sources, {fd.requirement}):")
+        for i, name in enumerate(fd.points):
+            d = fd.point_dict(name)
+            wb = d["worst_band"]
+            worst = (
+                f"worst band {wb['center_hz']:.3g} Hz ({wb['axis']}), margin {wb['margin']:.3g}"
+                if wb
+                else "no response"
+            )
+            verdict = "complies" if fd.complies[i] else "DOES NOT COMPLY"
+            click.echo(f"    {name}: {verdict}; {worst}")
     for w in result.warnings:
         click.echo(f"  warning: {w}")
     click.echo(f"report written to {path / 'report.html'}")

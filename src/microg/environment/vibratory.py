@@ -162,7 +162,7 @@ class VibratoryAssessment:
             top = np.argsort(-np.abs(m_share))[: self.max_modes]
             modes = [
                 {
-                    "mode": int(j),
+                    "mode": int(j) + 1,  # numbered as in the modes table (1-based)
                     "freq_hz": float(r.mode_freq_hz[j]),
                     "rms_g": float(m_rms[j]),
                     "share": float(m_share[j]),

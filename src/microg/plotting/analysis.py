@@ -20,6 +20,7 @@ __all__ = [
     "analysis_figure",
     "force_figure",
     "isolation_figure",
+    "live_axes",
     "model_figure",
     "modes_figure",
     "observation_figure",
@@ -206,8 +207,12 @@ def modes_figure(result: Analysis) -> Figure:
     return fig
 
 
-def _live_axes(accel: np.ndarray) -> list[int]:
-    """Axes whose signal is more than round-off of the largest (1e-9 of it)."""
+def live_axes(accel: np.ndarray) -> list[int]:
+    """Axes whose signal is more than round-off of the largest (above 1e-9 of it).
+
+    An axis the force cannot excite (y and z of a push along x on a symmetric station)
+    carries ~1e-16 of the others' signal: rounding, not physics.  Figures leave it out.
+    """
     peak = np.max(np.abs(accel), axis=1)
     top = float(peak.max()) if peak.size else 0.0
     return [i for i in range(accel.shape[0]) if top > 0 and peak[i] > 1e-9 * top] or [0]
@@ -217,7 +222,7 @@ def observation_figure(ob: Observation) -> Figure:
     """Acceleration history (micro-g) and 1/3-octave band RMS against the limit at a point."""
     r = ob.response
     a = ob.assessment
-    live = _live_axes(r.acceleration)
+    live = live_axes(r.acceleration)
     fig = Figure(figsize=(7.5, 6.4), layout="constrained")
     ax1, ax2 = fig.subplots(2, 1)
     for i in live:

@@ -5,8 +5,6 @@ from __future__ import annotations
 import re
 from typing import TYPE_CHECKING
 
-import numpy as np
-
 from microg._io import to_jsonable
 
 if TYPE_CHECKING:
@@ -50,18 +48,23 @@ def figures(result: Analysis) -> dict[str, bytes]:
 
     opts = result.options
     force_pts = {d.point: d.unit_direction for d in opts.disturbances}
+    if opts.sources is not None:
+        for s in opts.sources.sources:
+            force_pts.setdefault(s.at, s.direction)
+    observed = list(result.observations) or list(opts.observe)
     out = {
-        "model.png": png_bytes(
-            model_figure(result.structure, result.modes, force_pts, list(result.observations))
-        ),
-        "forces.png": png_bytes(force_figure(list(opts.disturbances), opts.duration_s)),
+        "model.png": png_bytes(model_figure(result.structure, result.modes, force_pts, observed)),
         "modes.png": png_bytes(modes_figure(result)),
     }
+    if opts.disturbances:
+        out["forces.png"] = png_bytes(force_figure(list(opts.disturbances), opts.duration_s))
     stems = figure_names(list(result.observations))
     for name, ob in result.observations.items():
         s = stems[name]
         r = ob.response
-        live = [i for i in range(3) if np.max(np.abs(r.acceleration[i])) > 0]
+        from microg.plotting.analysis import live_axes
+
+        live = live_axes(r.acceleration)
         axes = tuple("xyz"[i] for i in live) or ("x",)
         rows = live or [0]
         out[f"{s}-bands.png"] = png_bytes(observation_figure(ob))
@@ -85,6 +88,13 @@ def figures(result: Analysis) -> dict[str, bytes]:
         )
         if ob.isolation.package_accel is not None:
             out[f"{s}-isolated.png"] = png_bytes(isolation_figure(ob))
+    fd = result.frequency_domain
+    if fd is not None:
+        vstems = figure_names(list(fd.points))
+        for name in fd.points:
+            s = vstems[name]
+            out[f"{s}-vibratory.png"] = png_bytes(fd.plot(name, kind="bands"))
+            out[f"{s}-sources.png"] = png_bytes(fd.plot(name, kind="contributions"))
     return out
 
 
@@ -108,6 +118,27 @@ def render_analysis(result: Analysis, figs: dict[str, bytes]) -> str:
                 "figs": [uris[f"{s}-{k}.png"] for k in keys if f"{s}-{k}.png" in uris],
             }
         )
+    vib = []
+    fd = result.frequency_domain
+    if fd is not None:
+        vstems = figure_names(list(fd.points))
+        for name in fd.points:
+            s = vstems[name]
+            entry = data["frequency_domain"][name]
+            worst = entry.get("worst_band")
+            top = None
+            if worst is not None:
+                bands = entry["contributions"]["bands"]
+                band = next((b for b in bands if b["center_hz"] == worst["center_hz"]), None)
+                top = band
+            vib.append(
+                {
+                    "name": name,
+                    "data": entry,
+                    "worst": top,
+                    "figs": [uris[f"{s}-{k}.png"] for k in ("vibratory", "sources")],
+                }
+            )
     return (
         environment()
         .get_template("analyze.html")
@@ -115,8 +146,9 @@ def render_analysis(result: Analysis, figs: dict[str, bytes]) -> str:
             version=__version__,
             d=data,
             obs=obs,
+            vib=vib,
             model_fig=uris["model.png"],
-            forces_fig=uris["forces.png"],
+            forces_fig=uris.get("forces.png"),
             modes_fig=uris["modes.png"],
         )
     )
