@@ -319,3 +319,31 @@ def test_interval_margins_recomputed(station) -> None:
         margins.append(float(np.min(to.margin[:, np.asarray(to.resolved, bool)])))
     assert ob.interval["count"] == 2
     assert ob.interval["min_margin"] == pytest.approx(min(margins), rel=1e-9)
+
+
+def test_sources_frequency_domain_contract(station) -> None:
+    # analyze --sources adds `frequency_domain` keyed by observed point, with the transient
+    # block's band keys; it is the library's assess_sources on the same modes and damping
+    import microg
+    from microg.environment.sources import load_sources
+    from microg.environment.vibratory import assess_sources
+
+    r = microg.analyze(station, sources="example", observe=["lab"])
+    d = r.to_dict()
+    assert d["observations"] == {} and d["report_criterion"] is None  # no force: no transient
+    fd = d["frequency_domain"]["lab"]
+    keys = {"center_hz", "lower_hz", "upper_hz", "rms_g", "limit_g", "margin"}
+    assert keys <= set(fd["third_octave"]) and isinstance(fd["complies"], bool)
+    assert fd["contributions"]["bands"]
+    assert d["complies"] == fd["complies"]
+    modes = r.modes
+    ref = assess_sources(
+        modes, load_sources("example"), ["lab"], r.requirement, np.where(modes.rigid, 0, 0.005)
+    ).to_dict()["lab"]
+    assert fd["third_octave"]["rms_g"] == ref["third_octave"]["rms_g"]
+    # with a force too, both regimes are judged
+    both = microg.analyze(
+        station, force="crew-pushoff", sources="example", observe=["lab"], isolation=False
+    )
+    assert set(both.to_dict()["observations"]) == {"lab"} and both.frequency_domain is not None
+    assert both.complies == (both.observations["lab"].complies and fd["complies"])
