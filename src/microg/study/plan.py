@@ -1,0 +1,1194 @@
+"""The study file (TOML) and the case plan of a sweep.
+
+A study is the product of its axes (``docs/scale.md``)::
+
+    [study]
+    model = "ioc"                       # or a list: paths, shipped names, or tables
+    [axes]
+    force = ["foot-pushoff-max", "hand-pushoff-mean"]
+    at = ["crew", "vertical-lab"]
+    direction = ["x", "y", "z"]
+    observe = ["lab", "keel-tip"]
+    damping = [0.002, 0.005, 0.01]
+    isolator = [{ name = "none" }, { name = "soft", k1 = "50 N/m", zeta1 = 0.1 }]
+    variant = [{ name = "base" }, { name = "dock-aft", move = "main/Orbiter", to = [...] }]
+    [record]                            # defaults: microg.analysis.DEFAULTS
+    duration = "200 s"
+
+The full product is the default; ``[[case]]`` tables list sub-products instead (each fixes
+some axes to one value or a list; the axes it leaves out take all their values).  Extra named
+points (``[[point]]``, as in a station file) are added to every station model.
+
+Validation happens here, once: the file's structure (pydantic), every force (parsed), every
+point (present in each model it is used on), every variant (the mass exists, the position is
+on its carrier), the record.  Every error is one line naming the file and the field
+(``study.toml: axes.force[2]: ...``).  The plan holds SI values only.
+
+The case grid has one dimension per axis (:data:`CASE_DIMS`); it is cut into blocks
+(:class:`Block`): one model, variant, isolator, damping value and force, a run of application
+points, every direction and a run of observed points.  A block is the unit of work, of
+storage (one zarr chunk per variable) and of resumption.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import math
+import re
+import tomllib
+from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Annotated, Any
+
+import numpy as np
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    PlainValidator,
+    StrictBool,
+    StrictStr,
+    ValidationError,
+)
+
+from microg._vectors import axis_name, parse_direction
+from microg.analysis import DEFAULTS
+from microg.dynamics.forces import ForceHistory, activity_library, parse_force_spec
+from microg.errors import InputError
+from microg.isolation.timedomain import IsolatorModel
+from microg.models.messages import fail, structure_error, toml_repr
+from microg.models.schema import PointIn
+from microg.units import parse_quantity
+
+__all__ = [
+    "CASE_DIMS",
+    "MAX_CASES",
+    "MAX_AXIS_VALUES",
+    "MAX_STUDY_BYTES",
+    "BLOCK_CELLS",
+    "ModelItem",
+    "VariantItem",
+    "IsolatorItem",
+    "ForceItem",
+    "DirectionItem",
+    "Record",
+    "Discretisation",
+    "Block",
+    "Study",
+    "load_study",
+    "loads_study",
+]
+
+#: the case dimensions of the results, in storage order
+CASE_DIMS = ("model", "variant", "isolator", "damping", "force", "at", "direction", "observe")
+#: most cases of one study (the product or the listed cases)
+MAX_CASES = 100_000_000
+#: most values on one axis
+MAX_AXIS_VALUES = 100_000
+#: largest study file, bytes
+MAX_STUDY_BYTES = 4 * 2**20
+#: target number of cases of one block (a block is about a second of work on the IOC model)
+BLOCK_CELLS = 1024
+#: the analysis' limit on output samples, repeated: a record is refused beyond it
+MAX_SAMPLES = 2_000_000
+
+
+# ----------------------------------------------------------------------------- the schema
+
+
+def _quantity(value: Any) -> str | float:
+    if isinstance(value, str):
+        return value
+    if isinstance(value, int | float) and not isinstance(value, bool):
+        if not math.isfinite(value):
+            raise fail("not_finite", "expected a finite value", "give a finite number", value)
+        return float(value)
+    raise fail("quantity", "expected a number or a quantity", 'write e.g. "10 m"', value)
+
+
+def _number(value: Any) -> float:
+    if isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value):
+        return float(value)
+    raise fail("number", "expected a finite number", "write a number without quotes", value)
+
+
+def _direction(value: Any) -> str | list[float]:
+    if isinstance(value, str):
+        return value
+    if isinstance(value, list) and len(value) == 3:
+        return [_number(v) for v in value]
+    raise fail(
+        "direction", "expected an axis or three numbers", 'write "x", "-z" or [1, 0, 0]', value
+    )
+
+
+_Q = Annotated[str | float, PlainValidator(_quantity)]
+_Num = Annotated[float, PlainValidator(_number)]
+_Dir = Annotated[str | list[float], PlainValidator(_direction)]
+_Name = Annotated[StrictStr, Field(min_length=1, max_length=200)]
+
+
+class _In(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class ModelIn(_In):
+    """A model as a table: a path or shipped name, with the units and points of modal files."""
+
+    path: _Name
+    name: _Name | None = None
+    units: StrictStr | None = None
+    points: StrictStr | None = None
+
+
+_ModelRef = _Name | ModelIn
+
+
+class StudyIn(_In):
+    """``[study]``."""
+
+    name: _Name | None = None
+    description: Annotated[StrictStr, Field(max_length=2000)] = ""
+    model: _ModelRef | Annotated[list[_ModelRef], Field(min_length=1, max_length=1000)]
+    method: StrictStr = DEFAULTS["method"]
+    plane: StrictStr = DEFAULTS["plane"]
+    n: Annotated[int, Field(ge=1, le=10_000)] | None = None
+    n_modes: Annotated[int, Field(ge=1, le=2000)] | None = None
+    gravity_gradient: StrictBool = DEFAULTS["gravity_gradient"]
+    units: StrictStr | None = None
+    package_mass: _Q | None = None
+
+
+class IsolatorIn(_In):
+    """One mount design of the ``isolator`` axis."""
+
+    name: _Name
+    k1: _Q | None = None
+    f_n: _Q | None = None
+    zeta1: _Num = 0.0
+    package_mass: _Q | None = None
+    report_rule: StrictBool = False
+    band: Annotated[list[_Q], Field(min_length=2, max_length=2)] | None = None
+    target: _Num = 1.0
+    mu: _Num | None = None
+
+
+class VariantIn(_In):
+    """One model variant: the model as it is, a mass moved, or another model file."""
+
+    name: _Name
+    move: _Name | None = None
+    to: Annotated[list[_Q], Field(min_length=3, max_length=3)] | None = None
+    s: _Q | None = None
+    model: _ModelRef | None = None
+
+
+def _axis(item: Any) -> Any:
+    return Annotated[list[item], Field(max_length=MAX_AXIS_VALUES)]
+
+
+class AxesIn(_In):
+    """``[axes]``: the values of each axis (an axis left out takes its default)."""
+
+    force: _axis(_Name) | None = None  # type: ignore[valid-type]
+    at: _axis(_Name) | None = None  # type: ignore[valid-type]
+    direction: _axis(_Dir) | None = None  # type: ignore[valid-type]
+    observe: _axis(_Name) | None = None  # type: ignore[valid-type]
+    damping: _axis(_Num) | None = None  # type: ignore[valid-type]
+    isolator: _axis(IsolatorIn) | None = None  # type: ignore[valid-type]
+    variant: _axis(VariantIn) | None = None  # type: ignore[valid-type]
+
+
+class RecordIn(_In):
+    """``[record]``: the output record and the requirement (defaults: the analysis')."""
+
+    duration: _Q = DEFAULTS["duration_s"]
+    dt: _Q = DEFAULTS["dt_s"]
+    max_freq: _Q = DEFAULTS["max_freq_hz"]
+    requirement: StrictStr = DEFAULTS["requirement"]
+
+
+def _one_or_list(item: Any) -> Any:
+    return item | Annotated[list[item], Field(min_length=1, max_length=MAX_AXIS_VALUES)]
+
+
+class CaseIn(_In):
+    """``[[case]]``: a sub-product; each key fixes an axis to one value or a list of values."""
+
+    model: _one_or_list(_Name) | None = None  # type: ignore[valid-type]
+    variant: _one_or_list(_Name) | None = None  # type: ignore[valid-type]
+    isolator: _one_or_list(_Name) | None = None  # type: ignore[valid-type]
+    damping: _one_or_list(_Num) | None = None  # type: ignore[valid-type]
+    force: _one_or_list(_Name) | None = None  # type: ignore[valid-type]
+    at: _one_or_list(_Name) | None = None  # type: ignore[valid-type]
+    direction: _Dir | Annotated[list[_Dir], Field(min_length=1)] | None = None
+    observe: _one_or_list(_Name) | None = None  # type: ignore[valid-type]
+
+
+class StudyFileIn(_In):
+    """A whole study file."""
+
+    study: StudyIn
+    axes: AxesIn = AxesIn()
+    record: RecordIn = RecordIn()
+    case: Annotated[list[CaseIn], Field(max_length=100_000)] | None = None
+    point: Annotated[list[PointIn], Field(max_length=10_000)] = []
+
+
+# ------------------------------------------------------------------------------- the plan
+
+
+@dataclass(frozen=True)
+class ModelItem:
+    """One model of the study.
+
+    Attributes
+    ----------
+    label : name in the results (the ``model`` coordinate)
+    path : the path or shipped name as written (resolved against the study's folder)
+    model : the loaded model (Station, ModalModel or GraphModel), with the study's extra points
+    units, points : the unit declaration and points file of a modal file
+    derived : True when the model differs from its file (extra points added)
+    """
+
+    label: str
+    path: str
+    model: Any = field(repr=False)
+    units: str | None = None
+    points: str | None = None
+    derived: bool = False
+
+
+@dataclass(frozen=True)
+class VariantItem:
+    """One model variant: ``base`` (as is), ``move`` (a mass moved) or ``model`` (a file)."""
+
+    label: str
+    kind: str
+    move: str | None = None
+    to_m: np.ndarray | None = field(default=None, repr=False)
+    s_m: float | None = None
+    model: ModelItem | None = None
+
+
+@dataclass(frozen=True)
+class IsolatorItem:
+    """One mount design: the package on a spring (and damper, absorber), or none.
+
+    The package is driven by the observed point's acceleration (base excitation; its mass is
+    not fed back into the station), as in the isolation advice's time-domain check
+    (:func:`microg.isolation.timedomain.package_response`).
+    """
+
+    label: str
+    mount: IsolatorModel | None
+    description: str = ""
+
+
+@dataclass(frozen=True)
+class ForceItem:
+    """One force of the ``force`` axis: a spec as written and its history (s, N).
+
+    ``kind`` is ``"time"`` (a piecewise-linear history: library activity, spec, CSV file).  It
+    is the extension point for frequency-domain source catalogues (a future ``"catalogue"``
+    kind, see ``docs/scale.md``).
+    """
+
+    label: str
+    spec: str
+    history: ForceHistory = field(repr=False)
+    kind: str = "time"
+
+
+@dataclass(frozen=True)
+class DirectionItem:
+    """One force direction: its label and unit vector."""
+
+    label: str
+    vector: np.ndarray
+
+
+@dataclass(frozen=True)
+class Record:
+    """The output record and the requirement, SI."""
+
+    duration_s: float
+    dt_s: float
+    max_freq_hz: float
+    requirement: str
+
+    @property
+    def timepts(self) -> np.ndarray:
+        """Output times, s (as the analysis builds them)."""
+        return np.arange(0.0, self.duration_s + 0.5 * self.dt_s, self.dt_s)
+
+
+@dataclass(frozen=True)
+class Discretisation:
+    """How station models are discretised and how many modes are solved (analysis' options)."""
+
+    method: str = DEFAULTS["method"]
+    plane: str = DEFAULTS["plane"]
+    n: int | None = None
+    n_modes: int | None = None
+    gravity_gradient: bool = DEFAULTS["gravity_gradient"]
+
+
+@dataclass(frozen=True)
+class Block:
+    """A block of cases: one model, variant, isolator, damping and force; runs of at/observe.
+
+    Attributes
+    ----------
+    id : flat index in the block grid (C order)
+    index : (model, variant, isolator, damping, force) indices
+    at, observe : slices of the at and observe axes
+    n_cases : cases of the plan inside the block
+    """
+
+    id: int
+    index: tuple[int, int, int, int, int]
+    at: slice
+    observe: slice
+    n_cases: int
+
+
+@dataclass(frozen=True)
+class Study:
+    """A validated study: the axes, the record, the models, the case plan.
+
+    Attributes
+    ----------
+    file : the study file's name (for messages)
+    sha256 : of the study text
+    name, description
+    models, variants, isolators, damping, forces, at, directions, observe : the axes
+    record : Record
+    discretisation : Discretisation
+    case_sets : None (the full product) or per [[case]] the indices of each axis
+    text : the study file's text
+    warnings : what the user should know about the plan
+    """
+
+    file: str
+    sha256: str
+    name: str
+    description: str
+    models: tuple[ModelItem, ...]
+    variants: tuple[VariantItem, ...]
+    isolators: tuple[IsolatorItem, ...]
+    damping: tuple[float, ...]
+    forces: tuple[ForceItem, ...]
+    at: tuple[str, ...]
+    directions: tuple[DirectionItem, ...]
+    observe: tuple[str, ...]
+    record: Record
+    discretisation: Discretisation
+    case_sets: tuple[tuple[tuple[int, ...], ...], ...] | None = None
+    text: str = field(default="", repr=False)
+    warnings: tuple[str, ...] = ()
+
+    # ------------------------------------------------------------------ the grid
+    @property
+    def coords(self) -> dict[str, list[Any]]:
+        """The labels of every case dimension."""
+        return {
+            "model": [m.label for m in self.models],
+            "variant": [v.label for v in self.variants],
+            "isolator": [i.label for i in self.isolators],
+            "damping": list(self.damping),
+            "force": [f.label for f in self.forces],
+            "at": list(self.at),
+            "direction": [d.label for d in self.directions],
+            "observe": list(self.observe),
+        }
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        """Size of each case dimension (:data:`CASE_DIMS`)."""
+        return tuple(len(v) for v in self.coords.values())
+
+    @property
+    def chunks(self) -> tuple[int, ...]:
+        """Chunk size of each case dimension: one block per chunk."""
+        n_at, n_dir, n_obs = self.shape[5:]
+        co = min(n_obs, max(1, BLOCK_CELLS // n_dir))
+        ca = min(n_at, max(1, BLOCK_CELLS // (n_dir * co)))
+        return (1, 1, 1, 1, 1, ca, n_dir, co)
+
+    @property
+    def block_grid(self) -> tuple[int, ...]:
+        """Number of blocks along (model, variant, isolator, damping, force, at, observe)."""
+        s, c = self.shape, self.chunks
+        return (*s[:5], -(-s[5] // c[5]), -(-s[7] // c[7]))
+
+    def block(self, block_id: int) -> Block:
+        """The block with flat index ``block_id``."""
+        grid = self.block_grid
+        idx = np.unravel_index(block_id, grid)
+        ca, co = self.chunks[5], self.chunks[7]
+        a0, o0 = int(idx[5]) * ca, int(idx[6]) * co
+        at = slice(a0, min(a0 + ca, self.shape[5]))
+        obs = slice(o0, min(o0 + co, self.shape[7]))
+        head = (int(idx[0]), int(idx[1]), int(idx[2]), int(idx[3]), int(idx[4]))
+        mask = self.block_mask(head, at, obs)
+        return Block(block_id, head, at, obs, int(mask.sum()))
+
+    def block_mask(self, head: tuple[int, ...], at: slice, obs: slice) -> np.ndarray:
+        """(n_at, n_dir, n_obs) of bool: the cases of the plan inside a block."""
+        n_dir = self.shape[6]
+        shape = (at.stop - at.start, n_dir, obs.stop - obs.start)
+        if self.case_sets is None:
+            return np.ones(shape, bool)
+        mask = np.zeros(shape, bool)
+        for cs in self.case_sets:
+            if not all(h in cs[k] for k, h in enumerate(head)):
+                continue
+            a = np.zeros(shape[0], bool)
+            a[[i - at.start for i in cs[5] if at.start <= i < at.stop]] = True
+            d = np.zeros(n_dir, bool)
+            d[list(cs[6])] = True
+            o = np.zeros(shape[2], bool)
+            o[[i - obs.start for i in cs[7] if obs.start <= i < obs.stop]] = True
+            mask |= a[:, None, None] & d[None, :, None] & o[None, None, :]
+        return mask
+
+    def blocks(self) -> Iterator[Block]:
+        """Every block holding at least one case, in storage order."""
+        for b in range(int(np.prod(self.block_grid))):
+            blk = self.block(b)
+            if blk.n_cases:
+                yield blk
+
+    @property
+    def n_blocks(self) -> int:
+        """Number of blocks of the grid (with or without cases)."""
+        return int(np.prod(self.block_grid))
+
+    @property
+    def n_cases(self) -> int:
+        """Number of cases of the plan."""
+        if self.case_sets is None:
+            return int(np.prod(self.shape))
+        return sum(b.n_cases for b in self.blocks())
+
+    @property
+    def fingerprint(self) -> str:
+        """What identifies the computation (the study text and the microg version)."""
+        from microg import __version__
+
+        h = hashlib.sha256()
+        h.update(self.text.encode("utf-8"))
+        h.update(b"\0" + __version__.encode())
+        for m in (*self.models, *(v.model for v in self.variants if v.model is not None)):
+            h.update(b"\0" + _model_digest(m).encode())
+        for f in self.forces:
+            h.update(b"\0" + f.label.encode() + np.asarray(f.history.timepts).tobytes())
+            h.update(np.asarray(f.history.force).tobytes())
+        return h.hexdigest()
+
+    # ------------------------------------------------------------------ models
+    def variant_model(self, im: int, iv: int) -> Any:
+        """The model of (model ``im``, variant ``iv``): the base, a moved mass, or a file."""
+        base = self.models[im]
+        v = self.variants[iv]
+        if v.kind == "base":
+            return base.model
+        if v.kind == "model":
+            assert v.model is not None
+            return v.model.model
+        return _move(base.model, v, f"{self.file}: axes.variant[{iv}]")
+
+    def case(self, index: Sequence[int]) -> dict[str, Any]:
+        """The labels of the case at ``index`` (one index per case dimension)."""
+        return {d: self.coords[d][int(i)] for d, i in zip(CASE_DIMS, index, strict=True)}
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready summary of the plan."""
+        return {
+            "file": self.file,
+            "sha256": self.sha256,
+            "name": self.name,
+            "description": self.description,
+            "dims": list(CASE_DIMS),
+            "coords": self.coords,
+            "shape": list(self.shape),
+            "cases": self.n_cases,
+            "full_product": self.case_sets is None,
+            "record": dataclasses.asdict(self.record),
+            "discretisation": dataclasses.asdict(self.discretisation),
+            "models": [
+                {"label": m.label, "path": m.path, "units": m.units, "points": m.points}
+                for m in self.models
+            ],
+            "variants": [
+                {
+                    "label": v.label,
+                    "kind": v.kind,
+                    "move": v.move,
+                    "to_m": None if v.to_m is None else [float(x) for x in v.to_m],
+                    "s_m": v.s_m,
+                    "model": None if v.model is None else v.model.path,
+                }
+                for v in self.variants
+            ],
+            "isolators": [
+                {
+                    "label": i.label,
+                    "description": i.description,
+                    "mount": None if i.mount is None else dataclasses.asdict(i.mount),
+                }
+                for i in self.isolators
+            ],
+            "forces": [{"label": f.label, "spec": f.spec, "kind": f.kind} for f in self.forces],
+            "directions": [
+                {"label": d.label, "vector": [float(x) for x in d.vector]} for d in self.directions
+            ],
+            "warnings": list(self.warnings),
+        }
+
+
+def _model_digest(m: ModelItem) -> str:
+    src = getattr(m.model, "source", "") or ""
+    p = Path(src)
+    try:
+        if src and p.is_file():
+            return hashlib.sha256(p.read_bytes()).hexdigest()
+    except OSError:
+        pass
+    return f"{m.path}|{src}"
+
+
+# ------------------------------------------------------------------------------ reading
+
+
+def load_study(path: str | Path) -> Study:
+    """Read and validate a study file (see the module docstring and ``docs/scale.md``).
+
+    Parameters
+    ----------
+    path : str or Path
+        The TOML study file; relative paths inside it are relative to its folder.
+
+    Returns
+    -------
+    Study
+
+    Raises
+    ------
+    InputError
+        One line naming the file and the field.
+    """
+    p = Path(path)
+    label = str(path)
+    try:
+        with p.open("rb") as fh:
+            data = fh.read(MAX_STUDY_BYTES + 1)
+    except OSError as exc:
+        raise InputError(
+            f"cannot read the study file: {exc.strerror or exc}",
+            where=label,
+            fix="give the path of a TOML study file",
+        ) from None
+    if len(data) > MAX_STUDY_BYTES:
+        raise InputError(f"larger than {MAX_STUDY_BYTES // 2**20} MB", where=label)
+    try:
+        text = data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise InputError(f"not UTF-8 text (byte {exc.start})", where=label) from None
+    return loads_study(text, filename=label, base_dir=p.resolve().parent)
+
+
+_TOML_POS = re.compile(r"\s*\(at line (\d+), column (\d+)\)")
+
+
+def loads_study(text: str, *, filename: str = "<study>", base_dir: str | Path = ".") -> Study:
+    """Validate the text of a study file.
+
+    Parameters
+    ----------
+    text : the TOML text
+    filename : the file's name in messages
+    base_dir : folder against which relative paths (models, force files) are resolved
+
+    Returns
+    -------
+    Study
+    """
+    try:
+        raw = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        msg = str(exc)
+        m = _TOML_POS.search(msg)
+        where = f"{filename}: line {m.group(1)}, column {m.group(2)}" if m else filename
+        raise InputError(
+            f"invalid TOML: {' '.join(_TOML_POS.sub('', msg).split())}",
+            where=where,
+            fix="fix the TOML syntax there",
+        ) from None
+    if isinstance(raw.get("axes"), dict):
+        known = set(AxesIn.model_fields)
+        for key in raw["axes"]:
+            if key not in known:
+                raise InputError(
+                    f"unknown axis {key!r}",
+                    where=f"{filename}: axes.{key}",
+                    fix=f"the axes are {', '.join(AxesIn.model_fields)}",
+                )
+    try:
+        doc = StudyFileIn.model_validate(raw)
+    except ValidationError as exc:
+        err = structure_error(exc, filename, StudyFileIn)
+        raise InputError(err.what, where=err.where, fix=err.fix) from None
+    return _Builder(doc, filename, Path(base_dir), text).build()
+
+
+class _Builder:
+    def __init__(self, doc: StudyFileIn, file: str, base: Path, text: str):
+        self.doc, self.file, self.base, self.text = doc, file, base, text
+        self.warnings: list[str] = []
+
+    def where(self, path: str) -> str:
+        return f"{self.file}: {path}"
+
+    def err(self, path: str, what: str, fix: str | None = None) -> InputError:
+        return InputError(what, where=self.where(path), fix=fix)
+
+    def rewrap(self, exc: InputError, path: str) -> InputError:
+        inner = f"{exc.where}: {exc.what}" if exc.where else exc.what
+        return InputError(inner, where=self.where(path), fix=exc.fix)
+
+    def q(self, value: str | float, dim: str, path: str) -> float:
+        try:
+            return parse_quantity(value, dim, where=self.where(path), default_unit=self.bare(dim))
+        except InputError as exc:
+            raise InputError(exc.what, where=self.where(path), fix=exc.fix) from None
+
+    def bare(self, dim: str) -> str | None:
+        from microg.models.schema import UNIT_SYSTEMS
+        from microg.units import DIMENSIONS
+
+        units = self.doc.study.units
+        if units is None:
+            return DIMENSIONS.get(dim) or None
+        return UNIT_SYSTEMS.get(units, {}).get(dim)
+
+    # ---------------------------------------------------------------- models
+    def resolve(self, path: str) -> str:
+        from microg.models.catalog import shipped_models
+
+        if path in shipped_models():
+            return path
+        p = Path(path)
+        return str(p if p.is_absolute() else (self.base / p))
+
+    def model(self, ref: str | ModelIn, path: str) -> ModelItem:
+        from microg.models.load import load_model
+
+        spec = ref if isinstance(ref, ModelIn) else ModelIn(path=ref)
+        resolved = self.resolve(spec.path)
+        points = None if spec.points is None else self.resolve(spec.points)
+        try:
+            obj = load_model(resolved, units=spec.units, points=points)
+        except InputError as exc:
+            raise self.rewrap(exc, path) from None
+        label = spec.name or (spec.path if resolved == spec.path else Path(spec.path).stem)
+        item = ModelItem(label, resolved, obj, spec.units, points)
+        return self.with_points(item, path)
+
+    def with_points(self, item: ModelItem, path: str) -> ModelItem:
+        pts = self.doc.point
+        if not pts:
+            return item
+        from microg.models.station import Station
+        from microg.models.toml import dump_station, loads_station
+
+        if not isinstance(item.model, Station):
+            raise self.err(
+                "point",
+                f"extra points apply to station models only; model {item.label!r} is a "
+                f"{type(item.model).__name__}",
+                "name the points in the model's points file instead",
+            )
+        st = item.model
+        known = {p.name for p in st.points}
+        for i, p in enumerate(pts):
+            if p.name in known:
+                raise self.err(f"point[{i}].name", f"model {item.label!r} already has {p.name!r}")
+        lines = dump_station(st).splitlines()
+        if self.doc.study.units:
+            lines.insert(lines.index("[station]") + 1, f"units = {toml_repr(self.doc.study.units)}")
+        for p in pts:
+            lines += ["", "[[point]]"]
+            for key, value in p.model_dump(exclude_none=True).items():
+                lines.append(f"{key} = {toml_repr(value, 10_000)}")
+        offset = len(st.points)
+        try:
+            new = loads_station("\n".join(lines) + "\n", filename=self.file, source=st.source)
+        except InputError as exc:
+            where = re.sub(
+                r"point\[(\d+)\]", lambda m: f"point[{int(m.group(1)) - offset}]", exc.where or ""
+            )
+            raise InputError(exc.what, where=where, fix=exc.fix) from None
+        return dataclasses.replace(item, model=new, derived=True)
+
+    # ---------------------------------------------------------------- axes
+    def build(self) -> Study:
+        d = self.doc
+        refs = d.study.model if isinstance(d.study.model, list) else [d.study.model]
+        models = tuple(
+            self.model(r, "study.model" if len(refs) == 1 else f"study.model[{i}]")
+            for i, r in enumerate(refs)
+        )
+        self.unique([m.label for m in models], "study.model", "give each a name = ...")
+        disc = self.discretisation()
+        record = self.record()
+        ax = d.axes
+        variants = self.variants(ax.variant, models)
+        isolators = self.isolators(ax.isolator)
+        forces = self.forces(ax.force)
+        damping = self.damping(ax.damping)
+        directions = self.directions(ax.direction)
+        at = self.names(ax.at, "at")
+        observe = self.names(ax.observe, "observe")
+        if ax.at is None:
+            at = (self.default_crew(models[0].model),)
+        if ax.observe is None:
+            observe = self.default_observe(models[0].model)
+        case_sets = None
+        coords = {
+            "model": [m.label for m in models],
+            "variant": [v.label for v in variants],
+            "isolator": [i.label for i in isolators],
+            "damping": list(damping),
+            "force": [f.label for f in forces],
+            "at": list(at),
+            "direction": [x.label for x in directions],
+            "observe": list(observe),
+        }
+        if d.case is not None:
+            if not d.case:
+                raise self.err("case", "no [[case]] table", "list at least one case, or remove it")
+            case_sets = tuple(self.case_set(i, c, coords) for i, c in enumerate(d.case))
+        study = Study(
+            file=self.file,
+            sha256=hashlib.sha256(self.text.encode("utf-8")).hexdigest(),
+            name=d.study.name or Path(self.file).stem,
+            description=d.study.description,
+            models=models,
+            variants=variants,
+            isolators=isolators,
+            damping=damping,
+            forces=forces,
+            at=at,
+            directions=directions,
+            observe=observe,
+            record=record,
+            discretisation=disc,
+            case_sets=case_sets,
+            text=self.text,
+            warnings=tuple(self.warnings),
+        )
+        size = int(np.prod(study.shape))
+        if size > MAX_CASES:
+            raise self.err(
+                "axes",
+                f"the product of the axes has {size:,} cases, more than {MAX_CASES:,}",
+                "split the study, or list the cases wanted with [[case]] tables",
+            )
+        self.check_points(study)
+        self.check_record(study)
+        return study
+
+    def unique(self, labels: Sequence[Any], path: str, fix: str) -> None:
+        seen: set[Any] = set()
+        for i, lab in enumerate(labels):
+            if lab in seen:
+                raise self.err(f"{path}[{i}]", f"{lab!r} appears twice", fix)
+            seen.add(lab)
+
+    def empty(self, values: Sequence[Any] | None, name: str) -> None:
+        if values is not None and len(values) == 0:
+            raise self.err(
+                f"axes.{name}",
+                "empty axis: no case could be formed",
+                f"give at least one value, or leave {name} out for its default",
+            )
+
+    def discretisation(self) -> Discretisation:
+        s = self.doc.study
+        if s.method not in ("fem", "ritz"):
+            raise self.err("study.method", f"unknown method {s.method!r}", "use fem or ritz")
+        if s.plane not in ("3d", "xz", "yz"):
+            raise self.err("study.plane", f"unknown plane {s.plane!r}", "use 3d, xz or yz")
+        if s.units is not None and s.units not in ("SI", "US"):
+            raise self.err("study.units", f"unknown unit system {s.units!r}", "use SI or US")
+        return Discretisation(s.method, s.plane, s.n, s.n_modes, s.gravity_gradient)
+
+    def record(self) -> Record:
+        from microg.environment.requirements import requirement
+
+        r = self.doc.record
+        rec = Record(
+            duration_s=self.q(r.duration, "time", "record.duration"),
+            dt_s=self.q(r.dt, "time", "record.dt"),
+            max_freq_hz=self.q(r.max_freq, "frequency", "record.max_freq"),
+            requirement=r.requirement,
+        )
+        try:
+            requirement(r.requirement)
+        except InputError as exc:
+            raise InputError(
+                exc.what, where=self.where("record.requirement"), fix=exc.fix
+            ) from None
+        if not (rec.dt_s > 0 and rec.duration_s > rec.dt_s):
+            raise self.err(
+                "record.dt",
+                f"need 0 < dt < duration, got dt = {rec.dt_s:g} s, duration = {rec.duration_s:g} s",
+            )
+        if rec.duration_s / rec.dt_s > MAX_SAMPLES:
+            raise self.err(
+                "record.duration",
+                f"{rec.duration_s / rec.dt_s:.3g} output samples is more than {MAX_SAMPLES:,}",
+                "shorten the duration or lengthen dt",
+            )
+        if not rec.max_freq_hz > 0:
+            raise self.err("record.max_freq", f"must be > 0, got {rec.max_freq_hz:g} Hz")
+        return rec
+
+    def variants(self, raw: Sequence[VariantIn] | None, models: Sequence[ModelItem]) -> tuple:
+        self.empty(raw, "variant")
+        if raw is None:
+            return (VariantItem("base", "base"),)
+        out = []
+        for i, v in enumerate(raw):
+            path = f"axes.variant[{i}]"
+            given = [k for k in ("move", "model") if getattr(v, k) is not None]
+            if len(given) > 1:
+                raise self.err(path, "give move or model, not both")
+            if v.move is None and (v.to is not None or v.s is not None):
+                raise self.err(
+                    f"{path}.to", "a position without move = ...", 'add move = "body/mass"'
+                )
+            if v.model is not None:
+                if len(models) > 1:
+                    raise self.err(
+                        f"{path}.model",
+                        "a model-file variant replaces the model, so the study needs one model",
+                        "list the models in [study] model instead",
+                    )
+                out.append(VariantItem(v.name, "model", model=self.model(v.model, f"{path}.model")))
+                continue
+            if v.move is None:
+                out.append(VariantItem(v.name, "base"))
+                continue
+            if (v.to is None) == (v.s is None):
+                raise self.err(
+                    path,
+                    "a moved mass needs exactly one of to = [x, y, z] or s = (arc length on a "
+                    "beam)",
+                    'e.g. to = ["0 m", "0 m", "-40 m"]',
+                )
+            to = None
+            if v.to is not None:
+                to = np.array([self.q(c, "length", f"{path}.to[{k}]") for k, c in enumerate(v.to)])
+            s = None if v.s is None else self.q(v.s, "length", f"{path}.s")
+            item = VariantItem(v.name, "move", move=v.move, to_m=to, s_m=s)
+            for m in models:
+                _move(m.model, item, self.where(path))  # validates on every model
+            out.append(item)
+        self.unique([v.label for v in out], "axes.variant", "give each variant its own name")
+        return tuple(out)
+
+    def isolators(self, raw: Sequence[IsolatorIn] | None) -> tuple:
+        self.empty(raw, "isolator")
+        if raw is None:
+            return (IsolatorItem("none", None, "no isolator"),)
+        default_m = DEFAULTS["package_mass_kg"]
+        if self.doc.study.package_mass is not None:
+            default_m = self.q(self.doc.study.package_mass, "mass", "study.package_mass")
+        out = []
+        for i, r in enumerate(raw):
+            path = f"axes.isolator[{i}]"
+            m1 = (
+                default_m
+                if r.package_mass is None
+                else self.q(r.package_mass, "mass", f"{path}.package_mass")
+            )
+            if not m1 > 0:
+                raise self.err(f"{path}.package_mass", f"must be > 0, got {m1:g} kg")
+            if not 0.0 <= r.zeta1 < 1.0:
+                raise self.err(f"{path}.zeta1", f"must be 0 <= zeta1 < 1, got {r.zeta1:g}")
+            kinds = [k for k in ("k1", "f_n") if getattr(r, k) is not None]
+            if r.report_rule and kinds:
+                raise self.err(path, "give k1 (or f_n) or report_rule = true, not both")
+            if len(kinds) > 1:
+                raise self.err(f"{path}.f_n", "give k1 or f_n, not both")
+            if r.report_rule:
+                out.append(self.report_rule(r, m1, path))
+                continue
+            if not kinds:
+                if r.zeta1 or r.band is not None or r.mu is not None:
+                    raise self.err(path, "mount parameters without k1, f_n or report_rule")
+                out.append(IsolatorItem(r.name, None, "no isolator"))
+                continue
+            if r.k1 is not None:
+                k1 = self.q(r.k1, "stiffness", f"{path}.k1")
+            else:
+                assert r.f_n is not None
+                fn = self.q(r.f_n, "frequency", f"{path}.f_n")
+                k1 = m1 * (2 * math.pi * fn) ** 2
+            if not (k1 > 0 and math.isfinite(k1)):
+                raise self.err(f"{path}.k1", f"must be > 0, got {k1:g} N/m")
+            c1 = 2.0 * r.zeta1 * math.sqrt(k1 * m1)
+            fn_hz = math.sqrt(k1 / m1) / (2 * math.pi)
+            desc = (
+                f"package {m1:.4g} kg on k1 = {k1:.4g} N/m (f_n = {fn_hz:.4g} Hz), "
+                f"zeta1 = {r.zeta1:g}"
+            )
+            out.append(IsolatorItem(r.name, IsolatorModel(m1=m1, k1=k1, c1=c1), desc))
+        self.unique([x.label for x in out], "axes.isolator", "give each isolator its own name")
+        return tuple(out)
+
+    def report_rule(self, r: IsolatorIn, m1: float, path: str) -> IsolatorItem:
+        from microg.isolation.design import design_mount
+
+        if r.band is None:
+            raise self.err(
+                f"{path}.band",
+                "the report's rule sizes a mount for a band: required",
+                'add band = ["0.1 Hz", "1 Hz"]',
+            )
+        lo = self.q(r.band[0], "frequency", f"{path}.band[0]")
+        hi = self.q(r.band[1], "frequency", f"{path}.band[1]")
+        if not 0 < lo < hi:
+            raise self.err(f"{path}.band", f"need 0 < LO < HI, got {lo:g}, {hi:g} Hz")
+        if not 0 < r.target <= 1:
+            raise self.err(f"{path}.target", f"must be in (0, 1], got {r.target:g}")
+        try:
+            d = design_mount(m1, (2 * math.pi * lo, 2 * math.pi * hi), r.target, mu=r.mu)
+        except InputError as exc:
+            raise self.rewrap(exc, path) from None
+        mount = IsolatorModel(m1=m1, k1=d.k1, m2=d.m2 or 0.0, k2=d.k2 or 0.0, c=d.c or 0.0)
+        desc = (
+            f"report's rule for {lo:.4g}-{hi:.4g} Hz, M_a <= {r.target:g}: package {m1:.4g} kg "
+            f"on k1 = {d.k1:.4g} N/m" + (f" with an absorber (mu = {r.mu:g})" if r.mu else "")
+        )
+        return IsolatorItem(r.name, mount, desc)
+
+    def forces(self, raw: Sequence[str] | None) -> tuple:
+        self.empty(raw, "force")
+        specs = list(raw) if raw is not None else [DEFAULTS["force"]]
+        out = []
+        lib = ("crew-pushoff", *activity_library())
+        for i, spec in enumerate(specs):
+            path = f"axes.force[{i}]" if raw is not None else "axes.force"
+            head = spec.partition(":")[0].strip().lower()
+            resolved = spec
+            if head not in lib:
+                p = Path(spec)
+                resolved = str(p if p.is_absolute() else self.base / p)
+            try:
+                hist = parse_force_spec(resolved, where="force")
+            except InputError as exc:
+                raise self.rewrap(exc, path) from None
+            if hist.is_vector:
+                raise self.err(
+                    path,
+                    f"force {spec!r} changes direction in time; a sweep takes forces along one "
+                    "direction",
+                    "split it into components, or run microg analyze on it",
+                )
+            if hist.direction is not None:
+                self.warnings.append(
+                    f"force {spec!r} carries its own direction "
+                    f"({axis_name(hist.direction) or list(np.round(hist.direction, 6))}); the "
+                    "direction axis does not apply to it"
+                )
+            out.append(ForceItem(spec, resolved, hist))
+        self.unique([f.label for f in out], "axes.force", "list each force once")
+        return tuple(out)
+
+    def damping(self, raw: Sequence[float] | None) -> tuple[float, ...]:
+        self.empty(raw, "damping")
+        vals = list(raw) if raw is not None else [DEFAULTS["damping"]]
+        for i, z in enumerate(vals):
+            if not 0.0 <= z < 1.0:
+                raise self.err(f"axes.damping[{i}]", f"must be 0 <= zeta < 1, got {z!r}")
+        self.unique(vals, "axes.damping", "list each value once")
+        return tuple(float(z) for z in vals)
+
+    def directions(self, raw: Sequence[str | list[float]] | None) -> tuple:
+        self.empty(raw, "direction")
+        vals = list(raw) if raw is not None else [DEFAULTS["direction"]]
+        out = []
+        for i, v in enumerate(vals):
+            path = f"axes.direction[{i}]" if raw is not None else "axes.direction"
+            try:
+                u = parse_direction(v, self.where(path))
+            except InputError as exc:
+                raise InputError(exc.what, where=self.where(path), fix=exc.fix) from None
+            label = v if isinstance(v, str) else " ".join(f"{c:g}" for c in v)
+            out.append(DirectionItem(label, u))
+        self.unique([d.label for d in out], "axes.direction", "list each direction once")
+        return tuple(out)
+
+    def names(self, raw: Sequence[str] | None, name: str) -> tuple[str, ...]:
+        self.empty(raw, name)
+        vals = tuple(raw or ())
+        self.unique(vals, f"axes.{name}", "list each point once")
+        return vals
+
+    def default_crew(self, model: Any) -> str:
+        crew = [p for p, k in _point_names(model) if k == "crew"]
+        if not crew:
+            raise self.err(
+                "axes.at", "the model has no crew point", "list the points in at = [...]"
+            )
+        return crew[0]
+
+    def default_observe(self, model: Any) -> tuple[str, ...]:
+        pts = _point_names(model)
+        return tuple(p for p, k in pts if k == "experiment") or tuple(p for p, _ in pts)
+
+    def case_set(self, i: int, c: CaseIn, coords: Mapping[str, list[Any]]) -> tuple:
+        out = []
+        for dim in CASE_DIMS:
+            value = getattr(c, dim)
+            labels = coords[dim]
+            if value is None:
+                out.append(tuple(range(len(labels))))
+                continue
+            items = value if isinstance(value, list) and not _is_vec(value, dim) else [value]
+            idx = []
+            for k, item in enumerate(items):
+                key = item
+                if dim == "direction" and not isinstance(item, str):
+                    key = " ".join(f"{x:g}" for x in item)
+                if key not in labels:
+                    path = f"case[{i}].{dim}" + (f"[{k}]" if len(items) > 1 else "")
+                    shown = ", ".join(map(str, labels[:12]))
+                    raise self.err(
+                        path,
+                        f"{key!r} is not a value of the {dim} axis",
+                        f"add it to [axes] {dim}, or use one of: {shown}",
+                    )
+                idx.append(labels.index(key))
+            out.append(tuple(sorted(set(idx))))
+        return tuple(out)
+
+    def check_points(self, study: Study) -> None:
+        sets = study.case_sets or (tuple(tuple(range(n)) for n in study.shape),)
+        for im, m in enumerate(study.models):
+            for iv, v in enumerate(study.variants):
+                if not any(im in cs[0] and iv in cs[1] for cs in sets):
+                    continue
+                model = v.model.model if v.model is not None else m.model
+                label = v.model.label if v.model is not None else m.label
+                known = [p for p, _ in _point_names(model)]
+                for name in ("at", "observe"):
+                    k = CASE_DIMS.index(name)
+                    used = sorted({i for cs in sets if im in cs[0] and iv in cs[1] for i in cs[k]})
+                    for j in used:
+                        p = getattr(study, name)[j]
+                        if p not in known:
+                            given = getattr(self.doc.axes, name) is not None
+                            raise self.err(
+                                f"axes.{name}[{j}]" if given else f"axes.{name}",
+                                f"point {p!r} is not in model {label!r}",
+                                f"known points: {', '.join(known)}; or declare it in [[point]]",
+                            )
+
+    def check_record(self, study: Study) -> None:
+        rec = study.record
+        for i, f in enumerate(study.forces):
+            end = float(f.history.timepts[-1])
+            if end > rec.duration_s:
+                raise self.err(
+                    "record.duration",
+                    f"force {f.label!r} (axes.force[{i}]) lasts until {end:g} s, after the "
+                    f"{rec.duration_s:g}-s record ends",
+                    f"use a duration of at least {end:g} s (and time for the response to decay)",
+                )
+            fv = np.asarray(f.history.force, float)
+            last = float(fv[-1])
+            peak = float(np.max(np.abs(fv)))
+            if peak > 0 and abs(last) > 1e-9 * peak:
+                self.warnings.append(
+                    f"force {f.label!r} does not end at zero: it holds {last:.4g} N to the end "
+                    "of the record (a quasi-steady load, not a transient)"
+                )
+
+
+def _point_names(model: Any) -> list[tuple[str, str]]:
+    """(name, kind) of a model's named points (stations: a tuple; modal models: a mapping)."""
+    pts = getattr(model, "points", ())
+    if isinstance(pts, Mapping):
+        return [(n, getattr(p, "kind", "point")) for n, p in pts.items()]
+    return [(p.name, getattr(p, "kind", "point")) for p in pts]
+
+
+def _is_vec(value: Any, dim: str) -> bool:
+    """A direction written as three numbers (one value, not a list of three)."""
+    return dim == "direction" and len(value) == 3 and all(isinstance(v, float) for v in value)
+
+
+def _move(model: Any, v: VariantItem, where: str) -> Any:
+    """A copy of a station with the variant's mass moved (``to`` or ``s`` on its carrier)."""
+    from microg.location.layout import resolve_mass
+    from microg.models.schema import ON_AXIS_TOL
+    from microg.models.station import Beam, Station
+
+    if not isinstance(model, Station):
+        raise InputError(
+            f"a moved mass needs a station model, not a {type(model).__name__}",
+            where=where,
+            fix="give the variant as another model file: model = ...",
+        )
+    assert v.move is not None
+    try:
+        comp, pm = resolve_mass(model, v.move)
+    except InputError as exc:
+        raise InputError(exc.what, where=f"{where}.move", fix=exc.fix) from None
+    if isinstance(comp, Beam):
+        if v.s_m is not None:
+            s = v.s_m
+        else:
+            assert v.to_m is not None
+            to = np.asarray(v.to_m, float)
+            s = comp.arc_length(to)
+            off = float(np.linalg.norm(comp.station_position(s) - to))
+            if off > ON_AXIS_TOL * comp.length:
+                raise InputError(
+                    f"{v.move!r} rides on beam {comp.name!r}; the position is {off:.4g} m off "
+                    "its axis",
+                    where=f"{where}.to",
+                    fix="give a point on the beam, or s = (arc length from its root)",
+                )
+        if not -ON_AXIS_TOL * comp.length <= s <= comp.length * (1 + ON_AXIS_TOL):
+            raise InputError(
+                f"s = {s:.6g} m is off beam {comp.name!r} (0 to {comp.length:.6g} m)",
+                where=f"{where}.{'s' if v.s_m is not None else 'to'}",
+            )
+        pos = np.asarray(comp.station_position(min(max(s, 0.0), comp.length)), float)
+    else:
+        if v.to_m is None:
+            raise InputError(
+                f"{v.move!r} is on body {comp.name!r}: give its position to = [x, y, z]",
+                where=f"{where}.s",
+            )
+        pos = np.asarray(v.to_m, float)
+    new_pm = dataclasses.replace(pm, position=pos)
+
+    def moved(c: Any) -> Any:
+        if c.name != comp.name:
+            return c
+        return dataclasses.replace(c, masses=tuple(new_pm if m is pm else m for m in c.masses))
+
+    return dataclasses.replace(
+        model,
+        bodies=tuple(moved(b) for b in model.bodies),
+        beams=tuple(moved(b) for b in model.beams),
+    )

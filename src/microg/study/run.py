@@ -1,0 +1,541 @@
+"""Running a sweep: serially in this process, or as tasks on a Dask cluster.
+
+The same functions compute the same blocks on both paths (:mod:`microg.study.kernel`, with
+one BLAS thread), so both give the same bits:
+
+1. every model variant that has blocks left is solved once (:func:`~microg.study.kernel.
+   solve_basis`; on a cluster, one task per variant, so the eigen-solves run in parallel);
+2. the variant's modal basis (the modes at the study's points: small) is scattered to every
+   worker once (``client.scatter(basis, broadcast=True)``), with the small plan of the axes;
+3. its blocks are grouped into tasks of about a second (:data:`TASK_CASES` cases) and
+   submitted, at most a few per worker at a time; each result is written to the store as it
+   arrives (:class:`~microg.study.store.SweepStore`), and the progress callback is told.
+
+A task that raises is retried (:data:`RETRIES`); a worker that dies loses only the tasks it
+held, which the scheduler reruns elsewhere.  A sweep that stops (an error, an interrupt)
+leaves the blocks written readable and raises :class:`SweepIncompleteError`, which says how to
+resume: run the same sweep into the same directory; finished blocks are not recomputed.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections import deque
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from microg.errors import InputError, MicrogError
+from microg.study.kernel import Basis, BlockWork, KernelPlan, kernel_plan, run_blocks, solve_basis
+from microg.study.plan import Block, Study, load_study
+from microg.study.store import STORE_NAME, SweepStore
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+__all__ = [
+    "RETRIES",
+    "TASK_CASES",
+    "CONNECT_TIMEOUT_S",
+    "SweepIncompleteError",
+    "SweepResult",
+    "sweep",
+]
+
+#: times a failed task is retried (a worker's death is handled by the scheduler itself)
+RETRIES = 2
+#: cases per task (about a second on the shipped IOC model, 20,001-sample records)
+TASK_CASES = 1024
+#: at most this many modal groups (force, damping, isolator) per task
+TASK_GROUPS = 8
+#: seconds to wait for a scheduler to answer and to have a worker
+CONNECT_TIMEOUT_S = 10.0
+#: tasks in flight per worker thread
+IN_FLIGHT_PER_THREAD = 2
+
+TaskFn = Callable[[Basis, KernelPlan, Sequence[BlockWork], int], list[Any]]
+
+
+class SweepIncompleteError(MicrogError):
+    """A sweep stopped part-way; the blocks written are kept and the sweep can be resumed.
+
+    Attributes
+    ----------
+    done_blocks, total_blocks : blocks written and blocks of the plan
+    done_cases, total_cases : the same in cases
+    store : the store's path (None: in memory)
+    """
+
+    def __init__(
+        self,
+        cause: str,
+        *,
+        done_blocks: int,
+        total_blocks: int,
+        done_cases: int,
+        total_cases: int,
+        store: Path | None,
+        resume: str,
+    ):
+        self.done_blocks, self.total_blocks = done_blocks, total_blocks
+        self.done_cases, self.total_cases = done_cases, total_cases
+        self.store = store
+        kept = (
+            f"{store} holds the {done_blocks} blocks written ({done_cases:,} of "
+            f"{total_cases:,} cases; xarray.open_zarr reads them, computed marks them)"
+            if store is not None
+            else "the results were in memory and are lost"
+        )
+        super().__init__(f"sweep stopped after {done_blocks} of {total_blocks} blocks: {cause}; "
+                         f"{kept}; to resume, {resume}")  # fmt: skip
+
+
+# --------------------------------------------------------------------------- the result
+
+
+@dataclass
+class SweepResult:
+    """The result of :func:`sweep`: the dataset, the plan, the modes of each variant.
+
+    Attributes
+    ----------
+    study : the Study
+    store : the SweepStore (``store.path``: ``DIR/results.zarr``, or None in memory)
+    out : the output directory (None: in memory)
+    bases : ``"model/variant"`` -> the modes in its response (JSON-ready)
+    warnings : what the user should know (the plan's and each variant's)
+    computed_blocks, resumed_blocks : blocks computed by this call and found done
+    """
+
+    study: Study
+    store: SweepStore = field(repr=False)
+    out: Path | None = None
+    bases: dict[str, Any] = field(default_factory=dict)
+    warnings: list[str] = field(default_factory=list)
+    computed_blocks: int = 0
+    resumed_blocks: int = 0
+
+    @property
+    def dataset(self) -> Any:
+        """The results as a labelled ``xarray.Dataset`` (lazy: read from the store)."""
+        return self.store.dataset()
+
+    def to_xarray(self) -> Any:
+        """The results Dataset (dims and units in the attributes)."""
+        return self.dataset
+
+    def summary(self, heatmap: Sequence[str] | None = None, n_worst: int = 5) -> Any:
+        """The report's numbers: worst cases, complying fraction, heat map (see summary.py)."""
+        from microg.study.summary import summarize
+
+        return summarize(self, heatmap=heatmap, n_worst=n_worst)
+
+    def to_dict(self) -> dict[str, Any]:
+        """``{"cases", "complying_fraction", "worst", ...}``: the ``--json`` contract."""
+        return self.summary().to_dict()
+
+    def plot(self, heatmap: Sequence[str] | None = None) -> Figure:
+        """Heat map of the worst margin over two axes (a Figure)."""
+        from microg.plotting.study import heatmap_figure
+
+        return heatmap_figure(self.summary(heatmap=heatmap))
+
+    def case_model(self, model: str, variant: str) -> Any:
+        """The model object of (model, variant), as the sweep used it."""
+        im = self.study.coords["model"].index(model)
+        iv = self.study.coords["variant"].index(variant)
+        return self.study.variant_model(im, iv)
+
+    def analyze_case(self, case: dict[str, Any], **kwargs: Any) -> Any:
+        """Run :func:`microg.analyze` on one case alone (the per-case path), no isolator.
+
+        Parameters
+        ----------
+        case : labels of the case, one per case dimension (as in ``dataset.sel``)
+        kwargs : passed to :func:`microg.analyze` (e.g. ``isolation=False``)
+        """
+        from microg.analysis import analyze
+
+        s = self.study
+        f = s.forces[s.coords["force"].index(case["force"])]
+        d = s.directions[s.coords["direction"].index(case["direction"])]
+        disc, rec = s.discretisation, s.record
+        return analyze(
+            self.case_model(case["model"], case["variant"]),
+            force=f.spec,
+            at=case["at"],
+            direction=d.vector,
+            observe=[case["observe"]],
+            method=disc.method,
+            plane=disc.plane,
+            n=disc.n,
+            n_modes=disc.n_modes,
+            gravity_gradient=disc.gravity_gradient,
+            damping=float(case["damping"]),
+            duration=rec.duration_s,
+            dt=rec.dt_s,
+            max_freq=rec.max_freq_hz,
+            requirement=rec.requirement,
+            **kwargs,
+        )
+
+
+# ----------------------------------------------------------------------------- planning
+
+
+def _tasks(study: Study, blocks: Sequence[Block]) -> dict[tuple[int, int], list[list[BlockWork]]]:
+    """The blocks to do, per (model, variant), grouped into tasks of about TASK_CASES cases."""
+    out: dict[tuple[int, int], list[list[BlockWork]]] = {}
+    for b in blocks:
+        key = (b.index[0], b.index[1])
+        tasks = out.setdefault(key, [])
+        work = BlockWork(b.id, b.index, b.at, b.observe, study.block_mask(b.index, b.at, b.observe))
+        if tasks:
+            last = tasks[-1]
+            cases = sum(int(w.mask.sum()) for w in last)
+            groups = len({w.index[2:] for w in last} | {b.index[2:]})
+            if cases + b.n_cases <= TASK_CASES and groups <= TASK_GROUPS:
+                last.append(work)
+                continue
+        tasks.append([work])
+    return out
+
+
+def _solve_args(study: Study, im: int, iv: int) -> tuple[Any, dict[str, Any]]:
+    d, r = study.discretisation, study.record
+    return study.variant_model(im, iv), {
+        "model_label": study.models[im].label,
+        "variant_label": study.variants[iv].label,
+        "method": d.method,
+        "plane": d.plane,
+        "n": d.n,
+        "n_modes": d.n_modes,
+        "gravity_gradient": d.gravity_gradient,
+        "max_freq_hz": r.max_freq_hz,
+        "dt_s": r.dt_s,
+        "at": study.at,
+        "observe": study.observe,
+        "directions": np.array([x.vector for x in study.directions], float),
+        "where": f"{study.file}: record.dt",
+    }
+
+
+def _check_reach(study: Study, basis: Basis) -> list[str]:
+    """Refuse a force the model cannot carry (as the analysis does); warn of a partial one."""
+    bad = np.argwhere(basis.reach < 1e-9)
+    if bad.size and not all(f.history.direction is not None for f in study.forces):
+        ia, idr = (int(x) for x in bad[0])
+        raise InputError(
+            f"a force along {study.directions[idr].label!r} at {study.at[ia]!r} does no work on "
+            f"model {basis.model}/{basis.variant}: the response would be zero",
+            where=f"{study.file}: axes.direction[{idr}]",
+            fix="give directions the model can move in (in the plane of a planar model)",
+        )
+    part = np.argwhere(basis.reach < 1 - 1e-9)
+    return [
+        f"only {100 * basis.reach[ia, idr]:.3g}% of a force along "
+        f"{study.directions[idr].label!r} at {study.at[ia]!r} acts on the model; the rest is "
+        "dropped"
+        for ia, idr in part[:5]
+    ]
+
+
+# ----------------------------------------------------------------------------- running
+
+
+def _progress_none(done: int, total: int) -> None:
+    return None
+
+
+class _Runner:
+    """One sweep's loop: what is left, the store, progress, and the stop message."""
+
+    def __init__(
+        self,
+        study: Study,
+        store: SweepStore,
+        progress: Callable[[int, int], None] | None,
+        resume: str,
+    ):
+        self.study, self.store = study, store
+        self.progress = progress or _progress_none
+        self.resume = resume
+        self.total_cases = study.n_cases
+        blocks = list(study.blocks())
+        self.total_blocks = len(blocks)
+        done = store.done()
+        self.todo = [b for b in blocks if not done[b.id]]
+        self.block_of = {b.id: b for b in blocks}
+        self.done_blocks = self.total_blocks - len(self.todo)
+        self.resumed_blocks = self.done_blocks
+        self.done_cases = sum(b.n_cases for b in blocks if done[b.id])
+        self.bases: dict[str, Any] = store.bases()
+        self.warnings: list[str] = list(study.warnings)
+        self.tasks = _tasks(study, self.todo)
+
+    def start(self) -> None:
+        self.store.set_state("running")
+        self.progress(self.done_cases, self.total_cases)
+
+    def basis_done(self, basis: Basis) -> None:
+        extra = _check_reach(self.study, basis)
+        info = basis.to_dict()
+        info["warnings"] = list(basis.warnings) + extra
+        self.bases[f"{basis.model}/{basis.variant}"] = info
+        self.store.record_basis((basis.model, basis.variant), info)
+
+    def results(self, results: Sequence[Any]) -> None:
+        for r in results:
+            blk = self.block_of[r.id]
+            self.store.write(blk, r.values)
+            self.done_blocks += 1
+            self.done_cases += blk.n_cases
+            self.progress(self.done_cases, self.total_cases)
+
+    def stopped(self, cause: str) -> SweepIncompleteError:
+        self.store.set_state("stopped", cause=cause)
+        return SweepIncompleteError(
+            cause,
+            done_blocks=self.done_blocks,
+            total_blocks=self.total_blocks,
+            done_cases=self.done_cases,
+            total_cases=self.total_cases,
+            store=self.store.path,
+            resume=self.resume,
+        )
+
+    def finish(self) -> None:
+        self.store.set_state("complete")
+        for key, info in self.bases.items():
+            self.warnings += [f"{key}: {w}" for w in info.get("warnings", [])]
+
+
+def _serial(runner: _Runner, task_fn: TaskFn, threads: int) -> None:
+    s = runner.study
+    plan = kernel_plan(s)
+    for (im, iv), tasks in runner.tasks.items():
+        model, kw = _solve_args(s, im, iv)
+        basis = solve_basis(model, threads=threads, **kw)
+        runner.basis_done(basis)
+        for works in tasks:
+            runner.results(task_fn(basis, plan, works, threads))
+
+
+@contextmanager
+def _client(workers: int | None, scheduler: str | None, timeout_s: float) -> Iterator[Any]:
+    try:
+        from distributed import Client, LocalCluster
+    except ImportError:
+        raise InputError(
+            "Dask's distributed scheduler is not installed",
+            where="workers" if workers else "scheduler",
+            fix="pip install 'microg[sweep]' (dask[distributed])",
+        ) from None
+    if scheduler is not None:
+        try:
+            client = Client(scheduler, timeout=timeout_s)
+        except (OSError, TimeoutError, ValueError, TypeError) as exc:
+            reason = " ".join(str(exc).split())[:200]
+            raise InputError(
+                f"no Dask scheduler answered at {scheduler!r} within {timeout_s:g} s ({reason})",
+                where="scheduler",
+                fix="start one (dask scheduler, dask-jobqueue, dask-kubernetes) and give its "
+                "address, e.g. tcp://host:8786; or use --workers N for a local cluster",
+            ) from None
+        try:
+            try:
+                client.wait_for_workers(1, timeout=timeout_s)
+            except (TimeoutError, OSError):
+                raise InputError(
+                    f"the Dask scheduler at {scheduler!r} has no worker after {timeout_s:g} s",
+                    where="scheduler",
+                    fix="start workers for it (dask worker ADDRESS), or use --workers N",
+                ) from None
+            yield client
+        finally:
+            client.close()
+        return
+    assert workers is not None
+    cluster = LocalCluster(
+        n_workers=workers,
+        threads_per_worker=1,
+        processes=True,
+        dashboard_address=None,
+        silence_logs=logging.ERROR,
+    )
+    try:
+        client = Client(cluster)
+        try:
+            yield client
+        finally:
+            client.close()
+    finally:
+        cluster.close()
+
+
+def _distributed(runner: _Runner, client: Any, task_fn: TaskFn, threads: int) -> None:
+    from distributed import as_completed
+
+    s = runner.study
+    plan_f = client.scatter(kernel_plan(s), broadcast=True)
+    n_threads = max(1, sum(client.nthreads().values()))
+    limit = IN_FLIGHT_PER_THREAD * n_threads
+    meta: dict[str, tuple[str, Any]] = {}
+    ac = as_completed()
+    for im, iv in runner.tasks:
+        model, kw = _solve_args(s, im, iv)
+        model_f = client.scatter(model)  # a model may be large (a modal file's shapes)
+        f = client.submit(solve_basis, model_f, threads=threads, pure=False, retries=RETRIES, **kw)
+        meta[f.key] = ("basis", (im, iv))
+        ac.add(f)
+    queue: deque[tuple[Any, list[BlockWork]]] = deque()
+    in_flight = 0
+    try:
+        for fut in ac:
+            kind, payload = meta.pop(fut.key)
+            result = fut.result()
+            fut.release()
+            if kind == "basis":
+                im, iv = payload
+                runner.basis_done(result)
+                basis_f = client.scatter(result, broadcast=True)
+                queue.extend((basis_f, works) for works in runner.tasks[(im, iv)])
+            else:
+                in_flight -= 1
+                runner.results(result)
+            while queue and in_flight < limit:
+                basis_f, works = queue.popleft()
+                f = client.submit(task_fn, basis_f, plan_f, works, threads, pure=False,
+                                  retries=RETRIES)  # fmt: skip
+                meta[f.key] = ("blocks", None)
+                ac.add(f)
+                in_flight += 1
+    except BaseException:
+        for f in list(ac.futures):
+            f.cancel()
+        raise
+
+
+def _prepare_out(study: Study, out: Path) -> Path:
+    """Check the output directory (new, empty, or microg's), mark it, write derived models."""
+    import json
+
+    from microg._io import RUN_MARKER, atomic_write_text, check_writable
+    from microg.models.station import Station
+    from microg.models.toml import dump_station
+    from microg.study.summary import model_file
+
+    target = check_writable(out, where="out")
+    try:
+        target.mkdir(parents=True, exist_ok=True)
+        marker = {"microg_run": 1, "files": [STORE_NAME, "report.html", "models"],
+                  "command": "sweep"}  # fmt: skip
+        atomic_write_text(target / RUN_MARKER, json.dumps(marker) + "\n")
+        for im, m in enumerate(study.models):
+            for iv, v in enumerate(study.variants):
+                if not (v.kind == "move" or m.derived or (v.model is not None and v.model.derived)):
+                    continue
+                st = study.variant_model(im, iv)
+                if isinstance(st, Station):
+                    (target / "models").mkdir(exist_ok=True)
+                    path = target / "models" / model_file(m.label, v.label)
+                    atomic_write_text(path, dump_station(st))
+    except OSError as exc:
+        raise InputError(
+            f"cannot write in {str(target)!r}: {exc.strerror or exc}",
+            where="out",
+            fix="choose a writable directory with free space",
+        ) from None
+    return target
+
+
+def sweep(
+    study: Study | str | Path,
+    out: str | Path | None = None,
+    *,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    timeout_s: float = CONNECT_TIMEOUT_S,
+    restart: bool = False,
+    progress: Callable[[int, int], None] | None = None,
+    resume_hint: str | None = None,
+    threads: int = 1,
+    _task_fn: TaskFn | None = None,
+) -> SweepResult:
+    """Run a study: every case by linearity, serially or on a Dask cluster, into one Dataset.
+
+    Parameters
+    ----------
+    study : Study, or the path of a study file (``docs/scale.md``)
+    out : output directory; the results go to ``out/results.zarr`` as they are computed (a
+        directory holding this study's results is resumed).  None: in memory
+    workers : start a local Dask cluster of this many worker processes (one thread each)
+    scheduler : address of a running Dask scheduler (``tcp://host:8786``); exclusive with
+        ``workers``
+    timeout_s : seconds to wait for the scheduler to answer and to have a worker
+    restart : discard results of another study in ``out`` instead of refusing
+    progress : called with (cases done, cases in the plan) as blocks are written
+    resume_hint : what to tell the user to do to resume (default: call sweep again)
+    threads : BLAS threads per task (1: the same bits on every path)
+
+    Returns
+    -------
+    SweepResult
+
+    Raises
+    ------
+    InputError
+        A bad study (one line naming the file and field), a bad output directory, a
+        scheduler that does not answer.
+    SweepIncompleteError
+        The sweep stopped part-way (the blocks written are kept; the message says how to
+        resume).
+    """
+    if not isinstance(study, Study):
+        study = load_study(study)
+    if workers is not None and scheduler is not None:
+        raise InputError("give workers or scheduler, not both", where="workers")
+    if workers is not None and not (isinstance(workers, int) and 1 <= workers <= 1024):
+        raise InputError(f"must be an integer from 1 to 1024, got {workers!r}", where="workers")
+    if not (np.isfinite(timeout_s) and timeout_s > 0):
+        raise InputError(f"must be > 0, got {timeout_s!r}", where="timeout")
+    out_dir = None if out is None else _prepare_out(study, Path(out))
+    store = SweepStore(study, None if out_dir is None else out_dir / STORE_NAME,
+                       restart=restart, where="out")  # fmt: skip
+    hint = resume_hint or (
+        f"call microg.sweep({study.file!r}, {str(out_dir)!r}) again"
+        if out_dir is not None
+        else "run the sweep again with an output directory"
+    )
+    runner = _Runner(study, store, progress, hint)
+    task_fn = _task_fn or run_blocks
+    runner.start()
+    try:
+        if runner.todo:
+            if workers is None and scheduler is None:
+                _serial(runner, task_fn, threads)
+            else:
+                with _client(workers, scheduler, timeout_s) as client:
+                    _distributed(runner, client, task_fn, threads)
+    except InputError:
+        store.set_state("stopped", cause="bad input")
+        raise
+    except KeyboardInterrupt:
+        raise runner.stopped("interrupted") from None
+    except Exception as exc:  # a failure part-way: keep what is written, say how to resume
+        cause = f"{type(exc).__name__}: {' '.join(str(exc).split())[:300]}"
+        raise runner.stopped(cause) from exc
+    runner.finish()
+    return SweepResult(
+        study=study,
+        store=store,
+        out=out_dir,
+        bases=runner.bases,
+        warnings=runner.warnings,
+        computed_blocks=runner.total_blocks - runner.resumed_blocks,
+        resumed_blocks=runner.resumed_blocks,
+    )

@@ -1,0 +1,383 @@
+"""The summary of a sweep: worst cases, complying fraction, heat maps, reproduction commands.
+
+:func:`summarize` reads the store once, block by block (memory bounded by one block,
+whatever the size of the study), and keeps:
+
+* the number of cases computed and the fraction that comply;
+* the worst cases per observed point (smallest margin; a case whose record resolves no
+  band, margin NaN, counts as worst: it cannot be shown to comply);
+* the worst margin over two chosen axes (the minimum over every other axis): the heat map;
+* the complying fraction for each value of each axis;
+* for any case, the ``microg analyze`` command line that reproduces it alone
+  (:func:`case_command`).
+"""
+
+from __future__ import annotations
+
+import shlex
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from microg.errors import InputError
+from microg.study.plan import CASE_DIMS, Study
+
+if TYPE_CHECKING:
+    from microg.study.run import SweepResult
+
+__all__ = [
+    "Summary",
+    "summarize",
+    "default_heatmap",
+    "case_command",
+    "case_python",
+    "model_file",
+    "check_heatmap",
+]
+
+#: requirement names as ``microg analyze --requirement`` spells them
+_CLI_REQUIREMENT = {"iss": "iss", "ssp41000": "ssp41000", "flat": "flat", "report-1e-5g": "flat"}
+
+
+@dataclass(frozen=True)
+class Summary:
+    """What the sweep's report and ``--json`` say.
+
+    Attributes
+    ----------
+    cases : cases computed; planned : cases of the plan
+    complying : cases that comply; complying_fraction : complying / cases (None: no case)
+    worst : per observed point, its worst cases (dicts: case labels, margin, peak, ...)
+    heatmap_dims : the two axes of the heat map; heatmap_labels : their labels
+    heatmap : (n1, n2) the worst margin over every other axis (NaN: nothing computed)
+    fraction_by : axis -> [(label, complying fraction or None), ...]
+    requirement, record : what the cases were judged against
+    bases : the modes of each variant; warnings : the sweep's warnings
+    out : the output directory (None: in memory)
+    study : the plan (JSON-ready)
+    worst_bands : per observed point, the band RMS (3, nb) of its worst case, with the
+        band centres, limits and which bands are judged (for the figure)
+    """
+
+    cases: int
+    planned: int
+    complying: int
+    complying_fraction: float | None
+    worst: dict[str, list[dict[str, Any]]]
+    heatmap_dims: tuple[str, str]
+    heatmap_labels: tuple[list[Any], list[Any]]
+    heatmap: np.ndarray = field(repr=False)
+    fraction_by: dict[str, list[tuple[Any, float | None]]] = field(repr=False)
+    requirement: str = ""
+    record: dict[str, Any] = field(default_factory=dict)
+    bases: dict[str, Any] = field(default_factory=dict, repr=False)
+    warnings: list[str] = field(default_factory=list)
+    out: str | None = None
+    study: dict[str, Any] = field(default_factory=dict, repr=False)
+    worst_bands: dict[str, dict[str, Any]] = field(default_factory=dict, repr=False)
+
+    def worst_list(self) -> list[dict[str, Any]]:
+        """The worst case of every observed point, worst first."""
+        rows = [v[0] for v in self.worst.values() if v]
+        return sorted(rows, key=_sort_key)
+
+    def to_dict(self) -> dict[str, Any]:
+        """``{"cases", "complying_fraction", "worst", ...}`` (the ``microg sweep --json``)."""
+        return {
+            "cases": self.cases,
+            "complying_fraction": self.complying_fraction,
+            "worst": self.worst_list(),
+            "planned": self.planned,
+            "complying": self.complying,
+            "worst_per_point": self.worst,
+            "heatmap": {
+                "dims": list(self.heatmap_dims),
+                "labels": [list(x) for x in self.heatmap_labels],
+                "margin": [[_num(v) for v in row] for row in self.heatmap],
+            },
+            "fraction_by": {
+                k: [{"value": lab, "complying_fraction": fr} for lab, fr in v]
+                for k, v in self.fraction_by.items()
+            },
+            "requirement": self.requirement,
+            "record": self.record,
+            "modes": self.bases,
+            "warnings": list(self.warnings),
+            "out": self.out,
+            "dataset": None if self.out is None else f"{self.out}/results.zarr",
+        }
+
+
+def _num(v: float) -> float | str | None:
+    if np.isnan(v):
+        return None
+    if np.isinf(v):
+        return "inf" if v > 0 else "-inf"
+    return float(v)
+
+
+def _sort_key(row: dict[str, Any]) -> tuple[float, float]:
+    m = row["margin"]
+    key = -np.inf if m is None else (np.inf if m == "inf" else float(m))
+    return (key, -float(row["peak_accel_g"] or 0.0))
+
+
+def default_heatmap(study: Study) -> tuple[str, str]:
+    """The heat map's axes when none are asked: at x observe when both vary, else the two
+    axes with the most values."""
+    sizes = dict(zip(CASE_DIMS, study.shape, strict=True))
+    varying = [d for d in CASE_DIMS if sizes[d] > 1]
+    if "at" in varying and "observe" in varying:
+        return ("at", "observe")
+    ranked = sorted(varying, key=lambda d: -sizes[d])[:2]
+    for d in ("at", "observe", "force", "direction"):
+        if len(ranked) >= 2:
+            break
+        if d not in ranked:
+            ranked.append(d)
+    order = [d for d in CASE_DIMS if d in ranked]
+    return (order[0], order[1])
+
+
+def check_heatmap(study: Study, dims: Sequence[str] | None) -> tuple[str, str]:
+    """The heat map's two axes: ``dims`` checked, or :func:`default_heatmap`."""
+    if dims is None:
+        return default_heatmap(study)
+    dims = [str(d).strip() for d in dims]
+    if len(dims) != 2 or dims[0] == dims[1] or any(d not in CASE_DIMS for d in dims):
+        raise InputError(
+            f"expected two different axes, got {','.join(dims)!r}",
+            where="heatmap",
+            fix=f"name two of: {', '.join(CASE_DIMS)}, e.g. at,observe",
+        )
+    return (dims[0], dims[1])
+
+
+def summarize(
+    result: SweepResult, heatmap: Sequence[str] | None = None, n_worst: int = 5
+) -> Summary:
+    """The summary of a sweep's results (one pass over the store, block by block).
+
+    Parameters
+    ----------
+    result : the SweepResult
+    heatmap : the two axes of the heat map (default: :func:`default_heatmap`)
+    n_worst : worst cases kept per observed point
+    """
+    study = result.study
+    dims = check_heatmap(study, heatmap)
+    shape = dict(zip(CASE_DIMS, study.shape, strict=True))
+    heat = np.full((shape[dims[0]], shape[dims[1]]), np.nan)
+    n_comp = {d: np.zeros(shape[d], np.int64) for d in CASE_DIMS}
+    n_ok = {d: np.zeros(shape[d], np.int64) for d in CASE_DIMS}
+    best: list[list[tuple[float, float, tuple[int, ...]]]] = [[] for _ in study.observe]
+    total = ok_total = 0
+    names = ("margin", "peak_accel_g", "complies", "computed")
+    for blk in study.blocks():
+        v = result.store.read(blk, names)
+        comp = v["computed"]
+        if not comp.any():
+            continue
+        index = [np.array([i]) for i in blk.index] + [
+            np.arange(blk.at.start, blk.at.stop),
+            np.arange(shape["direction"]),
+            np.arange(blk.observe.start, blk.observe.stop),
+        ]
+        full = [x[(None,) * 5] for x in (v["margin"], v["peak_accel_g"], comp, v["complies"])]
+        margin, peak, comp8, ok8 = full
+        ok8 = ok8 & comp8
+        total += int(comp8.sum())
+        ok_total += int(ok8.sum())
+        for k, d in enumerate(CASE_DIMS):
+            other = tuple(j for j in range(8) if j != k)
+            np.add.at(n_comp[d], index[k], comp8.sum(axis=other))
+            np.add.at(n_ok[d], index[k], ok8.sum(axis=other))
+        a, b = CASE_DIMS.index(dims[0]), CASE_DIMS.index(dims[1])
+        other = tuple(j for j in range(8) if j not in (a, b))
+        m = np.where(comp8, margin, np.nan)
+        with np.errstate(invalid="ignore"):
+            red = np.fmin.reduce(m, axis=other, initial=np.inf, where=comp8)
+        red = np.where(comp8.any(axis=other), red, np.nan)
+        if a > b:
+            red = red.T
+        sub = heat[np.ix_(index[a], index[b])]
+        heat[np.ix_(index[a], index[b])] = np.fmin(sub, red)
+        # worst cases per observed point in this block
+        key = np.where(np.isnan(margin), -np.inf, margin)
+        for jo, o in enumerate(index[7]):
+            kk = key[..., jo].ravel()
+            cc = comp8[..., jo].ravel()
+            cand = np.flatnonzero(cc)
+            if cand.size == 0:
+                continue
+            order = cand[np.lexsort((-peak[..., jo].ravel()[cand], kk[cand]))][:n_worst]
+            sub_shape = key[..., jo].shape
+            for flat in order:
+                loc = np.unravel_index(int(flat), sub_shape)
+                case = tuple(int(index[d][loc[d]]) for d in range(7)) + (int(o),)
+                best[o].append((float(kk[flat]), -float(peak[..., jo].ravel()[flat]), case))
+            best[o].sort(key=lambda x: (x[0], x[1]))
+            del best[o][n_worst:]
+        del margin, peak
+    worst: dict[str, list[dict[str, Any]]] = {}
+    bands: dict[str, dict[str, Any]] = {}
+    ds = result.dataset if any(best) else None
+    for o, rows in enumerate(best):
+        worst[study.observe[o]] = [_case_row(result, ds, case) for _, _, case in rows]
+        if rows:
+            assert ds is not None
+            point = ds.isel(dict(zip(CASE_DIMS, rows[0][2], strict=True)))
+            bands[study.observe[o]] = {
+                "case": worst[study.observe[o]][0]["case"],
+                "center_hz": np.asarray(point.band.values, float),
+                "rms_g": np.asarray(point.band_rms_g.values, float),
+                "limit_g": np.asarray(point.limit_g.values, float),
+                "judged": np.asarray(point.judged.values, bool),
+            }
+    fraction_by = {
+        d: [
+            (lab, (float(n_ok[d][i] / n_comp[d][i]) if n_comp[d][i] else None))
+            for i, lab in enumerate(study.coords[d])
+        ]
+        for d in CASE_DIMS
+    }
+    rec = study.record
+    return Summary(
+        cases=total,
+        planned=study.n_cases,
+        complying=ok_total,
+        complying_fraction=(ok_total / total) if total else None,
+        worst=worst,
+        heatmap_dims=dims,
+        heatmap_labels=(list(study.coords[dims[0]]), list(study.coords[dims[1]])),
+        heatmap=heat,
+        fraction_by=fraction_by,
+        requirement=rec.requirement,
+        record={
+            "duration_s": rec.duration_s,
+            "dt_s": rec.dt_s,
+            "max_freq_hz": rec.max_freq_hz,
+            "requirement": rec.requirement,
+        },
+        bases=dict(result.bases),
+        warnings=list(result.warnings),
+        out=None if result.out is None else str(result.out),
+        study=study.to_dict(),
+        worst_bands=bands,
+    )
+
+
+def _case_row(result: SweepResult, ds: Any, case: tuple[int, ...]) -> dict[str, Any]:
+    study = result.study
+    labels = study.case(case)
+    point = ds.isel(dict(zip(CASE_DIMS, case, strict=True)))
+    to = point.band_rms_g.values  # (3, nb)
+    lim = point.limit_g.values
+    judged = point.judged.values.astype(bool)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        margin_b = np.where(to > 0, lim / np.where(to > 0, to, 1.0), np.inf)
+    wb = None
+    if judged.any():
+        mm = np.where(judged[None, :], margin_b, np.inf)
+        ax, band = np.unravel_index(int(np.argmin(mm)), mm.shape)
+        wb = {
+            "center_hz": float(point.band.values[band]),
+            "axis": "xyz"[ax],
+            "rms_g": float(to[ax, band]),
+            "limit_g": float(lim[band]),
+        }
+    return {
+        "case": {k: (float(v) if k == "damping" else v) for k, v in labels.items()},
+        "index": [int(i) for i in case],
+        "margin": _num(float(point.margin.values)),
+        "peak_accel_g": float(point.peak_accel_g.values),
+        "rms_accel_g": float(point.rms_accel_g.values),
+        "complies": bool(point.complies.values),
+        "worst_band": wb,
+        "command": case_command(result, labels),
+        "python": case_python(result, labels),
+        "isolated": study.isolators[case[2]].mount is not None,
+    }
+
+
+def _model_ref(result: SweepResult, labels: dict[str, Any]) -> tuple[str | None, str]:
+    """(path for ``microg analyze``, or None when the CLI cannot load it; Python expression)."""
+    study = result.study
+    im = study.coords["model"].index(labels["model"])
+    iv = study.coords["variant"].index(labels["variant"])
+    m, v = study.models[im], study.variants[iv]
+    item = v.model if v.kind == "model" and v.model is not None else m
+    if v.kind == "move" or item.derived:
+        written = None
+        if result.out is not None:
+            written = str(result.out / "models" / model_file(m.label, v.label))
+        expr = f"microg.load_station({written!r})" if written else "<the variant's Station>"
+        return written, expr
+    if item.units is not None or item.points is not None:
+        expr = (
+            f"microg.models.load.load_model({item.path!r}, units={item.units!r}, "
+            f"points={item.points!r})"
+        )
+        return None, expr
+    return item.path, repr(item.path)
+
+
+def model_file(model: str, variant: str) -> str:
+    """File name of a derived model written beside the results (``models/NAME.toml``)."""
+    from microg._io import safe_filenames
+
+    key = f"{model}--{variant}"
+    return safe_filenames([key])[key] + ".toml"
+
+
+def case_command(result: SweepResult, labels: dict[str, Any]) -> str | None:
+    """The ``microg analyze`` command line that reproduces one case alone (no isolator).
+
+    None when the command line cannot express the case (a modal file needing units, or the
+    gravity-gradient option): :func:`case_python` always can.
+    """
+    study = result.study
+    path, _ = _model_ref(result, labels)
+    d, r = study.discretisation, study.record
+    if path is None or d.gravity_gradient:
+        return None
+    force = study.forces[study.coords["force"].index(labels["force"])]
+    direc = study.directions[study.coords["direction"].index(labels["direction"])]
+    dtext = (
+        direc.label
+        if direc.label.lstrip("+-") in ("x", "y", "z")
+        else " ".join(repr(float(x)) for x in direc.vector)
+    )
+    args = ["microg", "analyze", path, "--force", force.spec, "--at", labels["at"],
+            "--direction", dtext, "--observe", labels["observe"],
+            "--damping", repr(float(labels["damping"])), "--method", d.method]  # fmt: skip
+    if d.method == "ritz":
+        args += ["--plane", d.plane]
+    if d.n is not None:
+        args += ["--elements", str(d.n)]
+    if d.n_modes is not None:
+        args += ["--n-modes", str(d.n_modes)]
+    args += [
+        "--max-freq", f"{r.max_freq_hz!r} Hz", "--duration", f"{r.duration_s!r} s",
+        "--dt", f"{r.dt_s!r} s", "--requirement", _CLI_REQUIREMENT.get(r.requirement, "iss"),
+    ]  # fmt: skip
+    return " ".join(shlex.quote(a) for a in args)
+
+
+def case_python(result: SweepResult, labels: dict[str, Any]) -> str:
+    """The Python call that reproduces one case alone with :func:`microg.analyze`."""
+    study = result.study
+    _, model = _model_ref(result, labels)
+    d, r = study.discretisation, study.record
+    force = study.forces[study.coords["force"].index(labels["force"])]
+    direc = study.directions[study.coords["direction"].index(labels["direction"])]
+    return (
+        f"microg.analyze({model}, force={force.spec!r}, at={labels['at']!r}, "
+        f"direction={[float(x) for x in direc.vector]!r}, observe=[{labels['observe']!r}], "
+        f"damping={float(labels['damping'])!r}, method={d.method!r}, plane={d.plane!r}, "
+        f"n={d.n!r}, n_modes={d.n_modes!r}, gravity_gradient={d.gravity_gradient!r}, "
+        f"max_freq={r.max_freq_hz!r}, duration={r.duration_s!r}, dt={r.dt_s!r}, "
+        f"requirement={r.requirement!r})"
+    )

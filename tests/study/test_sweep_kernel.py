@@ -1,0 +1,177 @@
+"""Every case of a sweep equals the per-case path (``microg.analyze``) run on it alone.
+
+References (independent of the sweep's linear algebra):
+
+* :func:`microg.analyze` on the case alone: its own modal solve, modal forces, modal
+  response, point projection, assessment and certified exact peak;
+* for an isolated case, :func:`microg.isolation.timedomain.package_response` on each axis of
+  the analysis' record, then :func:`microg.environment.metrics.assess` (the isolation advice's
+  time-domain check);
+* :func:`microg.dynamics.response.peak_response` over the whole record, for the pruning of
+  the exact-peak search.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from microg.dynamics.response import peak_response
+from microg.environment.metrics import assess
+from microg.isolation.timedomain import package_response
+from microg.study import CASE_DIMS, loads_study, sweep
+from microg.units import G0
+
+TEXT = """
+[study]
+model = "ioc"
+[axes]
+force = ["foot-pushoff-max", "hand-pushoff-mean"]
+at = ["crew", "vertical-lab", "keel-mid"]
+direction = ["x", "-y", [0.6, 0, 0.8]]
+observe = ["lab", "keel-tip", "boom-tip"]
+damping = [0.002, 0.02]
+isolator = [{ name = "none" }, { name = "soft", f_n = "0.1 Hz", zeta1 = 0.1 }]
+variant = [
+  { name = "base" },
+  { name = "dock-fwd", move = "main/Orbiter", to = ["0 ft", "0 ft", "-60 ft"] },
+]
+[record]
+duration = "60 s"
+dt = "0.1 s"
+max_freq = "2 Hz"
+[[point]]
+name = "keel-mid"
+on = "keel"
+s = "148 ft"
+"""
+
+# cases across every axis: (variant, isolator, damping, force, at, direction, observe)
+CASES = [
+    (0, 0, 0, 0, 0, 0, 0),
+    (0, 0, 1, 1, 1, 1, 1),
+    (0, 0, 0, 1, 2, 2, 2),
+    (1, 0, 1, 0, 2, 1, 0),
+    (1, 0, 0, 0, 1, 2, 1),
+    (0, 1, 0, 0, 0, 1, 2),
+    (1, 1, 1, 1, 2, 0, 1),
+]
+
+
+@pytest.fixture(scope="module")
+def result():
+    return sweep(loads_study(TEXT, filename="study.toml"))
+
+
+@pytest.fixture(scope="module")
+def data(result):
+    return result.dataset.load()
+
+
+def _close(x: np.ndarray, ref: np.ndarray, floor: float) -> None:
+    """Equal to 1e-9 relative, except values at rounding level of the case's scale.
+
+    ``floor`` is the case's own scale (its peak, or its largest band RMS) times 1e-12: an axis
+    the force does not drive (a y push observed on the symmetry plane) carries only rounding,
+    ~1e-16 of the scale, in both paths, and its relative difference means nothing.
+    """
+    np.testing.assert_allclose(x, ref, rtol=1e-9, atol=floor * 1e-12)
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_a_case_equals_analyze_on_it_alone(result, data, case) -> None:
+    index = (0, *case)
+    labels = result.study.case(index)
+    point = data.isel(dict(zip(CASE_DIMS, index, strict=True)))
+    a = result.analyze_case(labels, isolation=False)
+    ob = a.observations[labels["observe"]]
+    mount = result.study.isolators[case[1]].mount
+    if mount is None:
+        ref = ob.assessment
+    else:  # the package on its mount, driven by the analysis' record (base excitation)
+        t = ob.response.timepts
+        pkg = np.array([package_response(mount, t, row).package_accel for row in
+                        ob.response.acceleration])  # fmt: skip
+        ref = assess(t, pkg, a.requirement)
+    scale = ref.peak_accel_g
+    _close(point.peak_accel_g.values, ref.peak_accel_g, scale)
+    _close(point.peak_accel_g_axis.values, ref.peak_accel_g_axis, scale)
+    _close(point.rms_accel_g.values, ref.rms_accel_g, scale)
+    _close(point.rms_accel_g_axis.values, ref.rms_accel_g_axis, scale)
+    bands = ref.third_octave.rms_g
+    _close(point.band_rms_g.values, bands, float(bands.max()))
+    assert np.array_equal(point.band.values, ref.third_octave.center_hz)
+    assert np.array_equal(point.limit_g.values, ref.third_octave.limit_g)
+    assert np.array_equal(point.judged.values, ref.third_octave.resolved)
+    _close(point.margin.values, ref.worst_band.margin, 1.0)
+    assert bool(point.complies.values) == bool(ref.complies)
+    assert bool(point.computed.values)
+
+
+def test_exact_peaks_lie_in_the_analysis_certified_interval(result, data) -> None:
+    for case in CASES:
+        if result.study.isolators[case[1]].mount is not None:
+            continue
+        index = (0, *case)
+        labels = result.study.case(index)
+        pk = result.analyze_case(labels, isolation=False).observations[labels["observe"]].peak
+        mine = float(data.peak_accel_g.values[index]) * G0
+        # the analysis certifies the supremum in [peak, upper]; the sweep's search is tighter
+        # (rtol 1e-10), so its value lies in that interval up to the last rounding
+        assert pk.peak_accel_mps2 * (1 - 2e-10) <= mine <= pk.upper_bound_mps2 * (1 + 1e-15)
+        assert mine >= pk.sampled_peak_accel_mps2 * (1 - 1e-15)
+
+
+def test_the_pruned_exact_peak_equals_the_whole_record_search(result) -> None:
+    """The windows searched miss no maximum: the same search over the whole record agrees."""
+    from microg.study.kernel import (
+        BlockWork,
+        _coefficients,
+        _exact_peaks,
+        kernel_plan,
+        modal_group,
+        solve_basis,
+    )
+    from microg.study.run import _solve_args
+
+    s = result.study
+    plan = kernel_plan(s)
+    model, kw = _solve_args(s, 0, 0)
+    basis = solve_basis(model, **kw)
+    blk = s.block(0)
+    work = BlockWork(blk.id, blk.index, blk.at, blk.observe, s.block_mask(blk.index, blk.at,
+                                                                        blk.observe))  # fmt: skip
+    group = modal_group(basis, plan, 0, 0, 0)
+    force = plan.forces[0]
+    c, _ = _coefficients(basis, plan, group, work, force)
+    got = _exact_peaks(c, group, force, plan.timepts)
+    m = c.shape[2]
+    maps = {str(i): c[i] for i in range(c.shape[0])}
+    full = peak_response(group.omega, group.zeta, np.eye(m), maps, [(force, np.ones(m))],
+                         plan.timepts, rtol=1e-12)  # fmt: skip
+    ref = np.array([full[str(i)].peak_accel_mps2 for i in range(c.shape[0])])
+    ref_ax = np.array([full[str(i)].peak_accel_mps2_axis for i in range(c.shape[0])])
+    np.testing.assert_allclose(got["peak"], ref, rtol=2e-10)  # both certified to <= 1e-10
+    np.testing.assert_allclose(got["peak_axis"], ref_ax, rtol=2e-10, atol=1e-12 * ref.max())
+
+
+def test_the_rigid_modes_share_one_row(result) -> None:
+    from microg.study.kernel import kernel_plan, modal_group, solve_basis
+    from microg.study.run import _solve_args
+
+    s = result.study
+    model, kw = _solve_args(s, 0, 0)
+    basis = solve_basis(model, **kw)
+    g = modal_group(basis, kernel_plan(s), 0, 0, 0)
+    assert basis.rigid.sum() == 6
+    assert g.rows.shape == (basis.omega.size - 5, basis.omega.size)
+    # each mode goes to exactly one row; the rigid ones to the same row
+    assert np.all(g.rows.sum(axis=0) == 1)
+    assert np.count_nonzero(g.rows[:, basis.rigid].any(axis=1)) == 1
+
+
+def test_every_case_of_the_plan_is_computed(data, result) -> None:
+    assert int(data.computed.sum()) == result.study.n_cases
+    assert np.all(np.isfinite(data.peak_accel_g.values))
+    assert data.band_rms_g.dims == (*CASE_DIMS, "axis", "band")
+    assert data.band_rms_g.attrs["units"] == "g"
