@@ -273,7 +273,7 @@ def _elastic_inverse_iteration(
     def op(y: np.ndarray) -> np.ndarray:
         # ARPACK applies OPinv to M x with x M-orthogonal to the rigid span: the load is
         # self-equilibrated already (B^T M x = 0), so only the output is projected
-        x = np.array(g(np.asarray(y, float).reshape(n, -1)), float).reshape(n, -1)
+        x = np.asarray(g(np.asarray(y, float).reshape(n, -1)), float).reshape(n, -1)
         x -= B @ (MBt @ x)
         return x.reshape(np.shape(y))
 
