@@ -378,3 +378,10 @@ def test_csv_header_unit_9_pow_9_pow_9(tmp_path):
     p = write(tmp_path, "time [9**9**9 s],force [N]\n0,0\n1,1\n")
     with pytest.raises(InputError, match="line 1: the unit of the time column is not a unit"):
         from_csv(p)
+
+
+@pytest.mark.parametrize("gap", ["\n", "   \n", "\t\n", "# c\n", "\n\n"])
+def test_csv_blank_and_comment_lines_anywhere(tmp_path, gap):
+    p = write(tmp_path, f"time [s],force [N]\n{gap}0,0\n{gap}1,2\n {gap}2,0\n")
+    h = from_csv(p)
+    assert np.array_equal(h.timepts, [0, 1, 2]) and np.array_equal(h.force, [0, 2, 0])

@@ -782,7 +782,7 @@ def stations(draw) -> Station:
         draw(_pos),
         draw(st.floats(0, 1e6)),
         draw(st.none() | _pos),
-        draw(st.floats(0, 1e3)),
+        draw(st.just(0.0) | st.floats(1e-6, 1e3)),  # 0, or at least 1 mg/m (the limits)
     )
     s_mass = draw(st.floats(0, 1)) * length
     lo, hi = sorted(

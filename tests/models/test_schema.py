@@ -84,13 +84,20 @@ def test_point_at_x_1e300_ft() -> None:
         ('mass_per_length = "60 kg/m"', 'mass_per_length = "2e6 kg/m"', "beam[0].mass_per_length"),
         ('xx = "1.0e5 kg*m^2"', 'xx = "1e19 kg*m^2"', "body[0].mass[0].inertia.xx"),
         ('s = "40 m"', 's = "1e300 m"', "beam[0].mass[0].s"),
+        ('mass = "20000 kg"', 'mass = "1e-9 kg"', "body[0].mass[0].mass"),  # below 1 mg
+        ('weight = "98066.5 N"', 'weight = "1.1e-308 lbf"', "body[0].mass[1].weight"),
+        (
+            'mass_per_length = "60 kg/m"',
+            'mass_per_length = "1e-300 kg/m"',
+            "beam[0].mass_per_length",
+        ),
         ('weight_gravity = "9.80665 m/s^2"', 'weight_gravity = "1e-5 m/s^2"', "weight_gravity"),
     ],
 )
 def test_physical_limits_name_the_field(old: str, new: str, field: str) -> None:
     msg = error(mutate(old, new))
     assert f"m.toml: {field}" in msg or f"station.{field}" in msg
-    assert "limit" in msg or "must be" in msg
+    assert "limit" in msg or "must be" in msg or "smallest non-zero value" in msg
 
 
 def test_limits_are_documented() -> None:

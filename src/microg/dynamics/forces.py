@@ -18,6 +18,7 @@ Everything inside is SI (s, N).  Units are parsed here, at the boundary, with
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import re
 import tomllib
@@ -337,6 +338,7 @@ _HEADER_CELL = re.compile(
 )
 _BLANK_LINE = re.compile(r"(?:^|\n)[ \t\r]*(?:\n|$)")
 _NUMBER_CHARS = str.maketrans("", "", "0123456789eE+-. \t")
+_NUMBER_CHARS_AND_SEPARATORS = str.maketrans("", "", "0123456789eE+-. \t,\n")
 _STRICT_NUMBER = re.compile(
     r"^[ \t]*[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?[ \t]*$"
 )
@@ -533,7 +535,12 @@ def from_csv(path: str | Path, *, name: str | None = None) -> ForceHistory:
     rows = lines[data_start:]
     body = "\n".join(rows)
     linenos = np.arange(data_start + 1, data_start + 1 + len(rows))
-    if "#" in body or _BLANK_LINE.search(body):  # comments or blank lines between the rows
+    blank = (
+        (bool(rows) and not rows[0].strip())
+        or "\n\n" in body
+        or (("\n " in body or "\n\t" in body) and _BLANK_LINE.search(body) is not None)
+    )
+    if "#" in body or blank:  # comments or blank lines between the rows
         keep = [i for i, r in enumerate(rows) if r.strip() and not r.lstrip().startswith("#")]
         rows = [rows[i] for i in keep]
         linenos = linenos[keep]
@@ -542,10 +549,15 @@ def from_csv(path: str | Path, *, name: str | None = None) -> ForceHistory:
         raise InputError("need at least two rows of data", where=where)
     has_dir = "direction" in columns
     flat = None if '"' in body else body.replace("\n", ",").split(",")
+    numeric: np.ndarray | None = None
     if flat is not None and len(flat) == len(rows) * ncol:
-        grid = np.array(flat, dtype=object).reshape(len(rows), ncol)
+        if not has_dir and not body.translate(_NUMBER_CHARS_AND_SEPARATORS):
+            with contextlib.suppress(ValueError):  # a bad cell is found column by column
+                numeric = np.array(flat, dtype=float).reshape(len(rows), ncol)
+        grid = np.array(flat, dtype=object).reshape(len(rows), ncol) if numeric is None else None
 
         def col(key: str) -> list[str]:
+            assert grid is not None
             return grid[:, columns[key]].tolist()
 
     else:  # quotes, or rows of different lengths: cell by cell
@@ -565,10 +577,19 @@ def from_csv(path: str | Path, *, name: str | None = None) -> ForceHistory:
             return [c[i] if i < len(c) else "" for c in table]
 
     with np.errstate(over="ignore"):  # a value that overflows in SI is caught just below
-        times = _column(col("time"), "time", linenos, where) * t_scale
-        values = np.array(
-            [_column(col(k), k, linenos, where) * s for k, s in zip(fkeys, f_scales, strict=True)]
-        )
+        if numeric is not None:  # every cell a plain number: one conversion for the file
+            times = numeric[:, columns["time"]] * t_scale
+            values = np.array(
+                [numeric[:, columns[k]] * s for k, s in zip(fkeys, f_scales, strict=True)]
+            )
+        else:
+            times = _column(col("time"), "time", linenos, where) * t_scale
+            values = np.array(
+                [
+                    _column(col(k), k, linenos, where) * s
+                    for k, s in zip(fkeys, f_scales, strict=True)
+                ]
+            )
     for arr, key, limit, unit in (
         (times[None, :], "time", LIMITS["time"], "s"),
         (values, "force", LIMITS["force"], "N"),

@@ -99,6 +99,13 @@ class Builder:
             raise self.error(
                 path, f"{value!r} must not be negative", lim.why or "give a value >= 0"
             )
+        if 0.0 < abs(out) < lim.min_nonzero:
+            raise self.error(
+                path,
+                f"{value!r} is {out:.6g} {si}, below the smallest non-zero value "
+                f"{lim.min_nonzero:g} {si}",
+                lim.why or "give 0 or a value of physical size",
+            )
         if low or out > lim.hi:
             side = ("not above" if lim.lo_open else "below") if low else "beyond"
             bound = lim.lo if low else lim.hi

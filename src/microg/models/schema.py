@@ -31,6 +31,7 @@ __all__ = [
     "MAX_NAME",
     "MAX_TEXT",
     "MIN_BEAM_LENGTH",
+    "MIN_MASS",
     "ON_AXIS_TOL",
     "UNIT_SYSTEMS",
     "BeamIn",
@@ -105,6 +106,7 @@ class Limit:
     lo, hi : smallest and largest accepted values (SI unit of the dimension)
     lo_open : True when ``lo`` itself is not accepted (a strict lower bound)
     why : the reason for the bounds, for the message
+    min_nonzero : smallest accepted non-zero magnitude (zero itself stays accepted)
     """
 
     dimension: str
@@ -112,6 +114,7 @@ class Limit:
     hi: float
     lo_open: bool = False
     why: str = ""
+    min_nonzero: float = 0.0
 
 
 def _lim(dimension: str, lo: float | None, lo_open: bool = False, why: str = "") -> Limit:
@@ -119,7 +122,10 @@ def _lim(dimension: str, lo: float | None, lo_open: bool = False, why: str = "")
     return Limit(dimension, -hi if lo is None else lo, hi, lo_open, why)
 
 
-_MASS_WHY = "a mass is > 0 and at most 1e9 kg; zero only for a pure rotary inertia"
+_MASS_WHY = "a mass is 1 mg to 1e9 kg; zero only for a pure rotary inertia"
+#: smallest non-zero mass, kg, and mass per length, kg/m: below a milligram a mass is
+#: round-off, not a part of a station (and subnormal values break the solvers' scaling)
+MIN_MASS = 1e-6
 
 #: accepted range of each kind of field (SI); see docs/model-format.md, "Limits"
 FIELD_LIMITS: dict[str, Limit] = {
@@ -146,9 +152,15 @@ FIELD_LIMITS: dict[str, Limit] = {
     "weight_gravity": Limit(
         "acceleration", 0.1, 100.0, why="the gravity at which weights were measured"
     ),
-    "mass": Limit("mass", 0.0, LIMITS["mass"], why=_MASS_WHY),
+    "mass": Limit("mass", 0.0, LIMITS["mass"], why=_MASS_WHY, min_nonzero=MIN_MASS),
     "weight": Limit("force", 0.0, LIMITS["mass"] * 100.0, why=_MASS_WHY),
-    "mass_per_length": _lim("mass_per_length", 0.0),
+    "mass_per_length": Limit(
+        "mass_per_length",
+        0.0,
+        LIMITS["mass_per_length"],
+        why="a mass per length is 0, or 1 mg/m to 1e6 kg/m",
+        min_nonzero=MIN_MASS,
+    ),
     "weight_per_length": Limit("force_per_length", 0.0, LIMITS["mass_per_length"] * 100.0),
     "bending_stiffness": _lim("bending_stiffness", 0.0, lo_open=True),
     "torsional_stiffness": _lim("torsional_stiffness", 0.0),
