@@ -448,6 +448,7 @@ def test_package_mass_accepts_a_mass_or_a_weight() -> None:
             t.convert(bad, None, None)
 
 
+@pytest.mark.slow  # a full analysis with its report (about 8 s; run in CI too)
 def test_example_station_runs_as_in_the_readme(tmp_path: Path) -> None:
     # issue 9 sec. 3: microg analyze examples/station.toml --force examples/pushes.csv
     #                 --at hatch --observe rack3
