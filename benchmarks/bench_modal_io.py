@@ -26,6 +26,7 @@ from microg.models.modal import (
     save_modal_model,
 )
 from microg.models.uff import modal_model_from_uff, write_uff_modes
+from microg.structure.modal import modal_structure
 
 
 def make_model(g: int, m: int):
@@ -52,7 +53,7 @@ def make_model(g: int, m: int):
 def analyse(model) -> float:
     t0 = time.perf_counter()
     obs = [f"grid:{i}" for i in range(100, 20000, 1990)][:10]
-    st = model.to_structure(["grid:1", *obs], samples=False)
+    st = modal_structure(model, ["grid:1", *obs], samples=False)
     md = solve_modes(st)
     f = ForceHistory(np.array([0.0, 0.5, 1.0, 1.5]), np.array([0.0, 100.0, 100.0, 0.0]))
     b = generalized_force_vector(st.point("grid:1").translation, np.array([1.0, 0.0, 0.0]))

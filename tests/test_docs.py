@@ -59,7 +59,7 @@ def test_readme_example_runs_as_written(command: str, tmp_path: Path) -> None:
     args = shlex.split(command)
     env = dict(os.environ, MPLBACKEND="Agg")
     proc = subprocess.run(
-        [sys.executable, "-m", "microg", *args[1:], *(["--no-progress"] if _progress(args) else [])],
+        [sys.executable, "-m", "microg", *args[1:], *(["--no-progress"] * _progress(args))],
         cwd=tmp_path,
         capture_output=True,
         text=True,

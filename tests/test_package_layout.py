@@ -68,9 +68,13 @@ def _imports(tree: ast.AST) -> list[tuple[str, bool]]:
             return
         if isinstance(node, ast.Import):
             out.extend((a.name, top) for a in node.names if a.name.startswith("microg"))
-        elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
-            if node.module.startswith("microg"):
-                out.append((node.module, top))
+        elif (
+            isinstance(node, ast.ImportFrom)
+            and node.module
+            and node.level == 0
+            and node.module.startswith("microg")
+        ):
+            out.append((node.module, top))
         inner = top and not isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef | ast.Lambda)
         for child in ast.iter_child_nodes(node):
             visit(child, inner)

@@ -14,6 +14,7 @@ from microg.models.load import load_model
 from microg.models.nastran import Op2File, read_op2_modes
 from microg.models.toml import load_station
 from microg.structure.discretize import discretize
+from microg.structure.modal import modal_structure
 
 pytestmark = pytest.mark.nastran
 
@@ -157,5 +158,5 @@ def test_op4_model_from_maa_kaa(tmp_path):
     el = ~ref.rigid
     ne = int(el.sum())
     assert np.allclose(mm.omega[6 : 6 + ne], ref.omega[el], rtol=1e-7)
-    st = mm.to_structure(samples=False)
+    st = modal_structure(mm, samples=False)
     assert st.total_mass == pytest.approx(s.total_mass, rel=1e-10)

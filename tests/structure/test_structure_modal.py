@@ -12,6 +12,7 @@ from microg.errors import InputError
 from microg.models.modal import ModalPoint, build_modal_model, parse_units
 from microg.models.toml import load_station
 from microg.structure.discretize import discretize
+from microg.structure.modal import modal_structure
 
 pytestmark = pytest.mark.nastran
 
@@ -39,7 +40,7 @@ def fe():
 
 def test_matrices_and_exact_rigid_modes(fe):
     s, md, model = fe
-    st = discretize(model)  # the hook: ModalModel.to_structure()
+    st = discretize(model)  # the hook: modal_structure(ModalModel)
     assert st.method == "modal"
     assert np.array_equal(st.mass, np.eye(30))
     assert np.array_equal(np.diag(st.stiffness), model.omega**2)
@@ -54,7 +55,7 @@ def test_matrices_and_exact_rigid_modes(fe):
 
 def test_mass_properties_equal_the_fe_model(fe):
     s, _, model = fe
-    st = model.to_structure()
+    st = modal_structure(model)
     # reference: the FE model's own mass properties (independent assembly)
     assert st.total_mass == pytest.approx(s.total_mass, rel=1e-10)
     assert np.allclose(st.center_of_mass, s.center_of_mass, atol=1e-9 * 100)
@@ -72,7 +73,7 @@ def test_offset_point_includes_rotation(fe):
     node = int(nodes[0])
     off = lab.position - model.xyz_m[node]
     m = model.with_points([ModalPoint("lab", int(model.grid_ids[node]), off)])
-    st = m.to_structure()
+    st = modal_structure(m)
     # reference: FE translation map of the point applied to the FE modes
     assert np.allclose(
         st.point("lab").translation,
@@ -85,7 +86,7 @@ def test_response_equals_fe_response(fe):
     s, md, model = fe
     g_crew = 1 + int(np.flatnonzero(np.abs(s.point("crew").translation).sum(axis=0))[0] // 6)
     g_obs = 1 + int(np.flatnonzero(np.abs(s.point("keel-tip").translation).sum(axis=0))[0] // 6)
-    st = model.to_structure([f"grid:{g_crew}", f"grid:{g_obs}"], samples=False)
+    st = modal_structure(model, [f"grid:{g_crew}", f"grid:{g_obs}"], samples=False)
     m2 = solve_modes(st)
     f = ForceHistory(np.array([0.0, 0.5, 1.0, 1.5]), np.array([0.0, 100.0, 100.0, 0.0]))
     t = np.arange(0.0, 20.0, 0.01)
@@ -114,7 +115,7 @@ def test_response_equals_fe_response(fe):
 
 def test_maps_only_for_points_used_and_unknown_grid(fe):
     _, _, model = fe
-    st = model.to_structure(["grid:3"], samples=False)
+    st = modal_structure(model, ["grid:3"], samples=False)
     assert list(st.points) == ["grid:3"] and st.samples is None
     assert st.point("grid:5").translation.shape == (3, 30)  # on demand
     with pytest.raises(InputError, match="nearest grids"):

@@ -1124,7 +1124,9 @@ def _model_geometry(
         mass, cm, _ = model.mass_properties()
         named = [(p.name, p.kind, np.asarray(p.position, float)) for p in model.points]
         return model.name, float(mass), np.asarray(cm, float), named, ("station", elements)
-    structure = model.to_structure() if callable(getattr(model, "to_structure", None)) else model
+    from microg.structure.discretize import discretize
+
+    structure = discretize(model)
     named = [(n, "point", np.asarray(p.position, float)) for n, p in structure.points.items()]
     name = str(getattr(structure, "meta", {}).get("model", getattr(model, "name", "model")))
     return (
@@ -1167,8 +1169,9 @@ def quasi_steady(
 
     Parameters
     ----------
-    model : Station (its mass properties give the CM), or a Structure / object with
-        ``to_structure()`` (its ``center_of_mass`` and ``total_mass``)
+    model : Station (its mass properties give the CM), a Structure, or any model
+        :func:`~microg.structure.discretize.discretize` takes (the structure's
+        ``center_of_mass`` and ``total_mass``)
     orbit : circular orbit (default: the model's orbit radius and mu, ISS inclination 51.6 deg)
     attitude : default LVLH hold
     drag : default none (drag omitted, verdict withheld)

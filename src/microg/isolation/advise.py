@@ -14,9 +14,10 @@ The policy, in order:
    package (:func:`~microg.isolation.timedomain.package_response`).
 4. A mount is **recommended** only when that time-domain check complies and the record can
    see the mount's resonance (its natural frequency lies in a band the record resolves;
-   otherwise the advice names the record length needed) (``"passive-mount"``).  Otherwise no passive mount in the screen complies
-   (``"no-passive-mount"``): the advice says so, gives the attenuation needed per band, and
-   that active isolation is needed.  A design that fails its own check is never recommended.
+   otherwise the advice names the record length needed) (``"passive-mount"``).  Otherwise no
+   passive mount in the screen complies (``"no-passive-mount"``): the advice says so, gives
+   the attenuation needed per band, and that active isolation is needed.  A design that
+   fails its own check is never recommended.
 """
 
 from __future__ import annotations

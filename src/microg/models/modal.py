@@ -719,14 +719,6 @@ class ModalModel:
         merged.update({p.name: p for p in points})
         return replace(self, points=tuple(merged.values()))
 
-    def to_structure(self, points: Sequence[str] | None = None, *, samples: bool = True) -> Any:
-        """The :class:`~microg.structure.Structure` in modal coordinates (the hook of
-        :func:`microg.structure.discretize.discretize`); see
-        :func:`microg.structure.modal.modal_structure`."""
-        from microg.structure.modal import modal_structure
-
-        return modal_structure(self, points, samples=samples)
-
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready summary (no shapes)."""
         return {
