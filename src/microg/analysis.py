@@ -506,6 +506,19 @@ def _point_names(model: Any) -> list[tuple[str, str]]:
     return [(p.name, getattr(p, "kind", "point")) for p in pts]
 
 
+def _has_grids(model: Any) -> bool:
+    """True for imported models whose grids are points too (``grid:N``)."""
+    return hasattr(model, "grid_ids") or type(model).__name__ == "GraphModel"
+
+
+def _point(structure: Structure, name: str, where: str) -> Any:
+    """The structure's map of ``name``; an unknown name is an InputError naming ``where``."""
+    try:
+        return structure.point(name)
+    except InputError as exc:
+        raise InputError(exc.what, where=where, fix=exc.fix) from None
+
+
 def _check_points(names: Sequence[str], known: Sequence[str], where: str) -> None:
     for p in names:
         if p not in known:
@@ -658,8 +671,9 @@ def analyze(
             raise InputError(
                 f"{len(vals)} values for {nf} forces", where=name, fix="give one, or one per force"
             )
-    _check_points(at_list, known, "at")
-    _check_points(obs, known, "observe")
+    if not _has_grids(mdl):  # grid names (grid:N) of imported models resolve on the structure
+        _check_points(at_list, known, "at")
+        _check_points(obs, known, "observe")
     if len(set(obs)) != len(obs):
         raise InputError("a point is observed twice", where="observe", fix="name each point once")
     dists = []
@@ -963,11 +977,11 @@ def run_analysis(
     step("structure")
     structure = _structure(model, opts)
     for d in opts.disturbances:
-        structure.point(d.point)
+        _point(structure, d.point, "at")
     if opts.sources is not None:
         opts.sources.validate_points(structure.points)
     for name in opts.observe:
-        structure.point(name)
+        _point(structure, name, "observe")
     step("modes")
     n_req = None
     if structure.is_sparse:

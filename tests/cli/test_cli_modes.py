@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -70,7 +71,9 @@ def test_fem_plane_filter(capsys):
     rc, out, _ = _run(capsys, "ioc", "--method", "fem", "--elements", "2", "--json")
     assert rc == 0
     everything = json.loads(out)["modes"]
-    assert len(everything) == 20 and sum(m["rigid"] for m in everything) == 6
+    from microg.dynamics.modes import DEFAULT_N_MODES
+
+    assert len(everything) == DEFAULT_N_MODES and sum(m["rigid"] for m in everything) == 6
     rc, out, _ = _run(
         capsys,
         "ioc",
@@ -126,19 +129,55 @@ def test_bad_model_file_is_one_line(capsys, tmp_path):
     assert rc == 2 and out == "" and len(err.strip().splitlines()) == 1 and "bad.toml" in err
 
 
-def test_massless_beam_named(tmp_path, capsys) -> None:
-    # a beam with no mass makes M singular: the error names the coordinates that carry none
+def test_massless_beam_is_condensed_not_refused(tmp_path, capsys) -> None:
+    # issue 10 section 1: a beam with no mass, clamped to a massive body, is restrained, so its
+    # coordinates are condensed statically; the free-free model still has its 6 rigid modes
     model = tmp_path / "massless.toml"
     model.write_text(
         '[station]\nname = "m"\n[orbit]\naltitude = "400 km"\n[[body]]\nname = "core"\n'
         '  [[body.mass]]\n  name = "m"\n  at = ["0 m", "0 m", "0 m"]\n  mass = "1000 kg"\n'
+        '  inertia = { xx = "100 kg*m^2", yy = "100 kg*m^2", zz = "100 kg*m^2" }\n'
         '[[beam]]\nname = "arm"\nparent = "core"\nroot = ["0 m", "0 m", "0 m"]\n'
         'direction = [0, 0, 1]\nlength = "10 m"\nei = "1e6 N*m^2"\ngj = "1e6 N*m^2"\n'
         'mass_per_length = "0 kg/m"\n'
     )
-    from microg.cli import main as _main
-
     for method in ("ritz", "fem"):
-        rc = _main(["modes", str(model), "--method", method])
-        err = capsys.readouterr().err
-        assert rc == 2 and "arm" in err and "no mass" in err and err.count("\n") == 1
+        rc = main(["modes", str(model), "--method", method, "--json"])
+        out, err = capsys.readouterr()
+        assert rc == 0, err
+        modes = json.loads(out)["modes"]
+        assert sum(m["rigid"] for m in modes) == 6
+
+
+NASTRAN = Path(__file__).resolve().parents[1] / "data" / "nastran"
+
+
+def test_op2_modes_contract_with_replaced_rigid(capsys):
+    # a free-free SOL 103 (pyyeti's cla_residual.op2): the file's six near-zero modes come out
+    # as exact rigid-body modes, and the JSON says what was replaced and how far from zero
+    rc, out, err = _run(capsys, str(NASTRAN / "cla_residual.op2"), "--units", "in,lbf,s", "--json")
+    assert rc == 0, err
+    d = json.loads(out)
+    rigid = [m for m in d["modes"] if m["rigid"]]
+    assert len(rigid) == 6 and all(m["omega"] == 0.0 for m in rigid)
+    assert d["replaced_rigid"]["count"] == 6
+    assert 0 < d["replaced_rigid"]["max_file_freq_hz"] < 1e-3
+    assert d["method"] == "modal"
+
+
+def test_op2_needs_units(capsys):
+    rc, out, err = _run(capsys, str(NASTRAN / "cla_residual.op2"))
+    assert rc == 2 and out == "" and err.count("\n") == 1 and "units" in err
+
+
+def test_uff_export_round_trip_through_the_cli(capsys, tmp_path):
+    # modes exported as UFF 15+55 and read back (a modal model) give the same frequencies
+    # (6 printed digits in the standard single-precision datasets: 1e-5)
+    unv = tmp_path / "ioc.unv"
+    rc, out, _ = _run(capsys, "ioc", "--n-modes", "12", "--uff", str(unv), "--json")
+    assert rc == 0 and unv.is_file()
+    fe = np.array([m["omega"] for m in json.loads(out)["modes"]])
+    rc, out, err = _run(capsys, str(unv), "--json")
+    assert rc == 0, err
+    back = np.array([m["omega"] for m in json.loads(out)["modes"]])
+    np.testing.assert_allclose(back, fe, rtol=1e-5, atol=0)

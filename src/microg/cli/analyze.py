@@ -37,6 +37,9 @@ FLAGS = {
     "package_mass": "--package-mass/--package-weight",
     "absorber_mu": "--absorber-mu",
     "sources": "--sources",
+    "units": "--units",
+    "wtmass": "--wtmass",
+    "points": "--points",
     "out": "--out",
 }
 
@@ -164,6 +167,15 @@ def _weight_to_mass(text: str) -> str:
     default=None,
     help="Add a vibration absorber of this mass ratio to the report-rule mount.",
 )
+@click.option("--units", default=None, help="Units of a NASTRAN/UFF model: 'LENGTH,FORCE,TIME'.")
+@click.option("--wtmass", type=float, default=None, help="NASTRAN PARAM WTMASS of the run.")
+@click.option(
+    "--points",
+    "points_file",
+    type=click.Path(dir_okay=False, path_type=Path),
+    default=None,
+    help="TOML file naming grids of an imported model (lab = \"grid:2001\", with kinds).",
+)
 @click.option(
     "--sources",
     default=None,
@@ -199,6 +211,9 @@ def analyze(
     package_mass: str | None,
     package_weight: str | None,
     absorber_mu: float | None,
+    units: str | None,
+    wtmass: float | None,
+    points_file: Path | None,
     sources: str | None,
     out_dir: Path,
     as_json: bool,
@@ -246,9 +261,11 @@ def analyze(
             bar.update(1)
 
     command = "microg " + " ".join(shlex.quote(a) for a in sys.argv[1:])
+    reader = {k: v for k, v in (("units", units), ("wtmass", wtmass), ("points", points_file)) if v}
     with flag_errors(FLAGS):
+        mdl = microg.load_model(model, **reader) if reader else model
         result = microg.analyze(
-            model,
+            mdl,
             force=list(forces) or None,
             sources=sources,
             at=list(at_points) or None,

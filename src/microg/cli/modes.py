@@ -166,15 +166,24 @@ def modes(
             write_uff_modes(m, uff_out)
     plane_out = structure.plane if structure.plane else (plane if fem_plane else None)
     name = getattr(mdl, "name", None) or structure.meta.get("model", model)
+    replaced = structure.meta.get("replaced_rigid", {"count": 0, "max_file_freq_hz": None})
     if as_json:
         data = m.to_dict()
-        out = {"model": name, "plane": plane_out, **data}
+        out = {"model": name, "plane": plane_out, **data, "replaced_rigid": replaced}
+        warnings = list(structure.meta.get("warnings", ()))
+        if warnings:
+            out["warnings"] = warnings
         click.echo(dumps(out))
         return
     pct = _effective_percent(m)
     dirs = list(pct)
     where = f", plane {plane_out}" if plane_out else ""
     click.echo(f"{name}: {m.n_modes} modes ({m.method}{where}, {structure.n_dof} coordinates)")
+    if replaced and replaced.get("count"):
+        click.echo(
+            f"  {replaced['count']} of the file's modes replaced by exact rigid-body modes "
+            f"(largest file frequency among them {replaced.get('max_file_freq_hz', 0):.3g} Hz)"
+        )
     head = f"{'#':>3} {'omega (rad/s)':>14} {'f (Hz)':>11} {'rigid':>5} {'modal mass (kg)':>16}"
     head += "".join(f" {'eff ' + d + ' %':>9}" for d in dirs)
     click.echo(head)
