@@ -69,9 +69,7 @@ def heatmap_figure(summary: Summary) -> Figure:
 def _cmap() -> Any:
     import matplotlib
 
-    c = matplotlib.colormaps["RdYlGn"].copy()
-    c.set_bad("0.85")
-    return c
+    return matplotlib.colormaps["RdYlGn"].with_extremes(bad="0.85")
 
 
 def fraction_figure(summary: Summary) -> Figure:

@@ -1,0 +1,155 @@
+"""``microg sweep``: the contract, the report, reproduction of a case, one-line bad input."""
+
+from __future__ import annotations
+
+import json
+import shlex
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from microg.cli import main
+
+STUDY = """
+[study]
+name = "cli-test"
+model = "ioc"
+[axes]
+force = ["foot-pushoff-max", "hand-pushoff-mean"]
+at = ["crew", "keel-mid"]
+direction = ["x", "y"]
+observe = ["lab", "keel-tip"]
+damping = [0.002, 0.01]
+variant = [
+  { name = "base" },
+  { name = "dock-fwd", move = "main/Orbiter", to = ["0 ft", "0 ft", "-60 ft"] },
+]
+[record]
+duration = "40 s"
+dt = "0.1 s"
+max_freq = "2 Hz"
+[[point]]
+name = "keel-mid"
+on = "keel"
+s = "148 ft"
+"""
+
+
+def _run(capsys, args: list[str]) -> tuple[int, str, str]:
+    rc = main(args)
+    out, err = capsys.readouterr()
+    return rc, out, err
+
+
+@pytest.fixture(scope="module")
+def study_file(tmp_path_factory) -> Path:
+    d = tmp_path_factory.mktemp("study")
+    (d / "study.toml").write_text(STUDY)
+    return d / "study.toml"
+
+
+@pytest.fixture(scope="module")
+def run(study_file, tmp_path_factory):
+    out = tmp_path_factory.mktemp("sweep") / "out"
+    import contextlib
+    import io
+
+    buf = io.StringIO()
+    with contextlib.redirect_stdout(buf):
+        rc = main(["sweep", str(study_file), "--out", str(out), "--json", "--no-progress"])
+    assert rc == 0
+    return out, json.loads(buf.getvalue())
+
+
+def test_the_json_contract(run) -> None:
+    out, d = run
+    assert d["cases"] == 2 * 2 * 2 * 2 * 2 * 2
+    assert 0.0 <= d["complying_fraction"] <= 1.0
+    assert isinstance(d["worst"], list) and len(d["worst"]) == 2  # one per observed point
+    w = d["worst"][0]
+    assert set(w["case"]) == {
+        "model", "variant", "isolator", "damping", "force", "at", "direction", "observe"
+    }  # fmt: skip
+    assert w["command"].startswith("microg analyze ")
+    # worst first: the margins are sorted
+    assert w["margin"] <= d["worst"][1]["margin"]
+
+
+def test_the_files(run) -> None:
+    out, d = run
+    ds = xr.open_zarr(out / "results.zarr")
+    assert int(ds.computed.sum()) == d["cases"]
+    frac = float((ds.complies & ds.computed).sum() / ds.computed.sum())
+    assert frac == pytest.approx(d["complying_fraction"], rel=1e-15)
+    html = (out / "report.html").read_text()
+    for text in ("Worst cases per observed point", "Margin over at and observe", "microg analyze",
+                 "Complying fraction by axis", "data:image/png;base64,"):  # fmt: skip
+        assert text in html
+    assert (out / "models").is_dir()  # the moved-mass variant, for microg analyze
+
+
+def test_the_command_reproduces_the_worst_case(run, capsys, tmp_path: Path) -> None:
+    out, d = run
+    for w in d["worst"]:
+        args = shlex.split(w["command"])[1:]
+        rc, text, err = _run(capsys, [*args, "--out", str(tmp_path / "a"), "--json",
+                                      "--no-progress"])  # fmt: skip
+        assert rc == 0, err
+        ob = json.loads(text)["observations"][w["case"]["observe"]]
+        # microg analyze alone on that case: the same values (see test_sweep_kernel)
+        assert ob["peak_accel_g"] == pytest.approx(w["peak_accel_g"], rel=1e-9)
+        assert ob["rms_accel_g"] == pytest.approx(w["rms_accel_g"], rel=1e-9)
+        assert ob["worst_band"]["margin"] == pytest.approx(w["margin"], rel=1e-9)
+        assert ob["complies"] == w["complies"]
+
+
+def test_resume_prints_what_was_resumed(run, study_file, capsys) -> None:
+    out, _ = run
+    rc, text, err = _run(capsys, ["sweep", str(study_file), "--out", str(out), "--no-progress"])
+    assert rc == 0, err
+    assert "blocks resumed" in text and "report written" in text
+
+
+def test_heatmap_axes(run, study_file, capsys, tmp_path: Path) -> None:
+    out = tmp_path / "h"
+    args = ["sweep", str(study_file), "--out", str(out), "--json", "--no-progress"]
+    rc, text, err = _run(capsys, [*args, "--heatmap", "variant,force"])
+    assert rc == 0, err
+    hm = json.loads(text)["heatmap"]
+    assert hm["dims"] == ["variant", "force"]
+    assert np.asarray(hm["margin"], float).shape == (2, 2)
+    rc, _, err = _run(capsys, [*args, "--heatmap", "speed,force"])
+    assert rc == 2 and err.startswith("microg: error: --heatmap:")
+
+
+@pytest.mark.parametrize(
+    ("edit", "where"),
+    [
+        (("damping = [0.002, 0.01]", 'damping = [0.002, 0.01]\nspeed = ["fast"]'), "axes.speed"),
+        (('at = ["crew", "keel-mid"]', "at = []"), "axes.at"),
+        (('observe = ["lab", "keel-tip"]', 'observe = ["lab", "attic"]'), "axes.observe[1]"),
+        (('"hand-pushoff-mean"', '"missing.csv"'), "axes.force[1]"),
+    ],
+)
+def test_bad_study_one_line_exit_2(edit, where, tmp_path: Path, capsys) -> None:
+    f = tmp_path / "bad.toml"
+    f.write_text(STUDY.replace(*edit))
+    rc, out, err = _run(capsys, ["sweep", str(f), "--out", str(tmp_path / "o"), "--no-progress"])
+    assert rc == 2
+    assert err.count("\n") == 1 and f"{f}: {where}" in err
+    assert not (tmp_path / "o").exists()  # nothing written
+
+
+def test_a_missing_study_file(tmp_path: Path, capsys) -> None:
+    rc, _, err = _run(capsys, ["sweep", str(tmp_path / "nope.toml"), "--no-progress"])
+    assert rc == 2 and "nope.toml" in err and err.count("\n") == 1
+
+
+def test_a_scheduler_that_does_not_answer(study_file, tmp_path: Path, capsys) -> None:
+    args = ["sweep", str(study_file), "--out", str(tmp_path / "o"), "--no-progress"]
+    rc, _, err = _run(capsys, [*args, "--scheduler", "tcp://127.0.0.1:9", "--timeout", "1"])
+    assert rc == 2 and err.startswith("microg: error: --scheduler:") and err.count("\n") == 1
+    rc, _, err = _run(capsys, [*args, "--scheduler", "tcp://127.0.0.1:9", "--workers", "2"])
+    assert rc == 2 and "--workers" in err

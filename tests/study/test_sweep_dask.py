@@ -1,0 +1,122 @@
+"""The distributed path: the same bits as the serial one, retried tasks, a worker that dies."""
+
+from __future__ import annotations
+
+import os
+import signal
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+distributed = pytest.importorskip("distributed")
+
+from microg.errors import InputError  # noqa: E402
+from microg.study import loads_study, sweep  # noqa: E402
+from microg.study.kernel import run_blocks  # noqa: E402
+
+TEXT = """
+[study]
+name = "dask-test"
+model = "ioc"
+[axes]
+force = ["foot-pushoff-max", "hand-pushoff-mean"]
+at = ["crew", "vertical-lab"]
+direction = ["x", "y", "z"]
+observe = ["lab", "keel-tip"]
+damping = [0.002, 0.01]
+isolator = [{ name = "none" }, { name = "soft", f_n = "0.1 Hz", zeta1 = 0.1 }]
+variant = [
+  { name = "base" },
+  { name = "dock-fwd", move = "main/Orbiter", to = ["0 ft", "0 ft", "-60 ft"] },
+]
+[record]
+duration = "40 s"
+dt = "0.1 s"
+max_freq = "2 Hz"
+"""
+
+#: the task functions below must travel to the workers by value (tests are not a package)
+import cloudpickle  # noqa: E402
+
+cloudpickle.register_pickle_by_value(sys.modules[__name__])
+
+
+def _study():
+    return loads_study(TEXT, filename="study.toml")
+
+
+@pytest.fixture(scope="module")
+def serial():
+    return sweep(_study()).dataset.load()
+
+
+def _assert_identical(ds, ref) -> None:
+    for name in ref.data_vars:
+        assert np.array_equal(ds[name].values, ref[name].values, equal_nan=True), name
+
+
+def test_two_local_workers_give_the_serial_bits(serial, monkeypatch) -> None:
+    monkeypatch.setattr("microg.study.run.TASK_CASES", 12)  # several tasks per variant
+    r = sweep(_study(), workers=2)
+    _assert_identical(r.dataset.load(), serial)
+    assert r.computed_blocks == len(list(r.study.blocks()))
+
+
+@pytest.fixture
+def cluster():
+    with distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
+        silence_logs=50,
+    ) as c:  # fmt: skip
+        yield c
+
+
+def _fail_once(marker: str):
+    def task(basis, plan, works, threads):
+        path = Path(marker) / f"{works[0].id}"
+        if not path.exists():
+            path.write_text("failed once")
+            raise RuntimeError("transient failure")
+        return run_blocks(basis, plan, works, threads)
+
+    return task
+
+
+def test_a_task_that_fails_is_retried(serial, cluster, tmp_path: Path, monkeypatch) -> None:
+    monkeypatch.setattr("microg.study.run.TASK_CASES", 12)
+    r = sweep(_study(), scheduler=cluster.scheduler_address, _task_fn=_fail_once(str(tmp_path)))
+    _assert_identical(r.dataset.load(), serial)
+    assert len(list(tmp_path.iterdir())) > 1  # every task failed once and was rerun
+
+
+def _die_once(marker: str):
+    def task(basis, plan, works, threads):
+        path = Path(marker) / "died"
+        if not path.exists():
+            path.write_text(str(os.getpid()))
+            os.kill(os.getpid(), signal.SIGKILL)  # the worker process dies mid-task
+        return run_blocks(basis, plan, works, threads)
+
+    return task
+
+
+def test_a_worker_that_dies_loses_only_its_batch(serial, cluster, tmp_path, monkeypatch) -> None:
+    monkeypatch.setattr("microg.study.run.TASK_CASES", 12)
+    r = sweep(_study(), scheduler=cluster.scheduler_address, _task_fn=_die_once(str(tmp_path)))
+    assert (tmp_path / "died").exists()  # a worker was killed during the sweep
+    _assert_identical(r.dataset.load(), serial)
+
+
+def test_a_scheduler_that_does_not_answer_is_one_line() -> None:
+    with pytest.raises(InputError) as info:
+        sweep(_study(), scheduler="tcp://127.0.0.1:9", timeout_s=1.0)
+    assert info.value.where == "scheduler"
+    assert "no Dask scheduler answered" in str(info.value) and "\n" not in str(info.value)
+
+
+def test_workers_and_scheduler_are_exclusive() -> None:
+    with pytest.raises(InputError) as info:
+        sweep(_study(), workers=2, scheduler="tcp://127.0.0.1:9")
+    assert info.value.where == "workers"
