@@ -347,3 +347,20 @@ def test_sources_frequency_domain_contract(station) -> None:
     )
     assert set(both.to_dict()["observations"]) == {"lab"} and both.frequency_domain is not None
     assert both.complies == (both.observations["lab"].complies and fd["complies"])
+
+
+def test_unstable_libration_refuses_a_transient_verdict() -> None:
+    # Iy < Iz with gravity gradient: a mode grows as exp(g t); the response has no bound, so
+    # the main job refuses (naming the inertia condition) rather than treat it as rigid
+    from pathlib import Path
+
+    import microg
+    from microg.errors import InputError
+
+    model = Path(__file__).parent / "data" / "models" / "solver_unstable.toml"
+    with pytest.raises(InputError) as exc:
+        microg.analyze(model, at="lab", gravity_gradient=True, duration=40, dt=0.02)
+    assert exc.value.where == "gravity_gradient" and "unstable" in str(exc.value)
+    assert "I_y" in str(exc.value)
+    # free-free, the same model is analysed
+    assert microg.analyze(model, at="lab", duration=40, dt=0.02, isolation=False).observations

@@ -26,7 +26,7 @@ import numpy as np
 
 from microg._vectors import axis_name, parse_direction
 from microg.dynamics.forces import ForceHistory, parse_force_spec
-from microg.dynamics.modes import Modes, solve_modes
+from microg.dynamics.modes import DEFAULT_N_MODES, Modes, solve_modes
 from microg.dynamics.response import (
     PeakResponse,
     PointResponse,
@@ -68,8 +68,6 @@ REPORT_LIMIT_G = 1e-5
 MAX_SAMPLES = 2_000_000
 #: interval over which the requirement's band RMS is stated (PIMS judges 100-s intervals)
 REQUIREMENT_INTERVAL_S = 100.0
-#: modes solved for sparse (frame) models when ``n_modes`` is not given
-DEFAULT_SPARSE_MODES = 60
 #: ... and when vibratory sources are assessed (their bands reach 300 Hz)
 DEFAULT_SOURCE_MODES = 300
 #: the defaults of :func:`analyze` and ``microg analyze``, SI
@@ -131,7 +129,7 @@ class AnalysisOptions:
         Elements per beam (fem) or functions per beam (ritz); None: the discretisation's
         default.
     n_modes : int or None
-        Modes to solve for sparse models (None: :data:`DEFAULT_SPARSE_MODES`).
+        Modes to solve for sparse models (None: :data:`~microg.dynamics.modes.DEFAULT_N_MODES`).
     zeta : float
         Modal damping ratio of the elastic modes.
     max_freq_hz : float
@@ -986,7 +984,7 @@ def run_analysis(
     n_req = None
     if structure.is_sparse:
         # the vibratory regime reaches 300 Hz: sources need the modes well above it
-        default = DEFAULT_SOURCE_MODES if opts.sources is not None else DEFAULT_SPARSE_MODES
+        default = DEFAULT_SOURCE_MODES if opts.sources is not None else DEFAULT_N_MODES
         n_req = min(structure.n_dof - 1, opts.n_modes or default)
     modes = solve_modes(structure, n_req)
     warnings: list[str] = []
@@ -1035,6 +1033,15 @@ def _transient(
 ) -> tuple[dict[str, Observation], np.ndarray, list[str]]:
     """The transient regime: exact response, assessment, exact peaks, isolation advice."""
     warnings: list[str] = []
+    if np.any(modes.unstable):
+        k = int(np.flatnonzero(modes.unstable)[0])
+        note = next((n for n in modes.notes if "unstable" in n), "")
+        raise InputError(
+            f"mode {k + 1} is unstable (growth rate {modes.growth_rate[k]:.3g} rad/s): the "
+            f"transient response grows without bound, so no verdict can be drawn. {note}",
+            where="gravity_gradient",
+            fix="analyse the free-free structure (no gravity gradient), or correct the inertias",
+        )
     maps = {name: structure.point(name).translation for name in opts.observe}
     if structure.is_sparse and not modes.rigid[-1] and modes.freq_hz[-1] <= opts.max_freq_hz:
         warnings.append(

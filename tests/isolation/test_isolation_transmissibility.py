@@ -51,7 +51,8 @@ def condition(k, mu, zeta, r):  # type: ignore[no-untyped-def]
     num_terms = 1 + s2 * q + g
     den = np.abs((1 - q) * (1 - s2 * q) - mu * q + 1j * g * (1 - (1 + mu) * q))
     den_terms = 1 + (1 + mu + s2) * q + s2 * q * q + g * (1 + (1 + mu) * q)
-    return np.maximum(num_terms / num, den_terms / den)
+    with np.errstate(divide="ignore"):  # exactly on a pole or a zero: infinitely ill-conditioned
+        return np.maximum(num_terms / num, den_terms / den)
 
 
 def test_direct_solve_1000_random_points() -> None:

@@ -61,7 +61,15 @@ def _profiles(station, structure, phi):
 
 
 def _mac(a, b):
-    return (a.T @ b) ** 2 / np.outer((a * a).sum(0), (b * b).sum(0))
+    """MAC of every column of a with every column of b.
+
+    A column of b whose x profile is below 1e-8 of the largest is an out-of-plane mode: its x
+    displacement is rounding, and MAC (which scales the size away) would pair noise.  Its
+    MAC is 0.
+    """
+    na, nb = (a * a).sum(0), (b * b).sum(0)
+    mac = (a.T @ b) ** 2 / np.outer(na, np.where(nb > 0, nb, 1.0))
+    return np.where(np.sqrt(nb) > 1e-8 * np.sqrt(nb.max()), mac, 0.0)
 
 
 def _lab_index(amap, structure):

@@ -41,6 +41,7 @@ FLAGS = {
     "wtmass": "--wtmass",
     "points": "--points",
     "out": "--out",
+    "gravity_gradient": "--gravity-gradient",
 }
 
 
@@ -128,6 +129,12 @@ def _weight_to_mass(text: str) -> str:
     "[default: 60]",
 )
 @click.option(
+    "--gravity-gradient/--free-free",
+    default=False,
+    show_default=True,
+    help="Restrain the rigid rotations by gravity gradient (libration); default free-free.",
+)
+@click.option(
     "--max-freq",
     default=None,
     help=f"Elastic modes up to this frequency enter the response. [default: "
@@ -204,6 +211,7 @@ def analyze(
     plane: str,
     elements: int | None,
     n_modes: int | None,
+    gravity_gradient: bool,
     max_freq: str | None,
     duration: str | None,
     dt: str | None,
@@ -274,6 +282,7 @@ def analyze(
             method=method,
             plane=plane,
             requirement=requirement,
+            gravity_gradient=gravity_gradient,
             progress=progress,
             command=command,
             **kwargs,

@@ -188,16 +188,20 @@ def modes(
     head += "".join(f" {'eff ' + d + ' %':>9}" for d in dirs)
     click.echo(head)
     for j in range(m.n_modes):
+        kind = "yes" if m.rigid[j] else ("UNST" if m.unstable[j] else "no")
         row = (
             f"{j + 1:>3} {m.omega[j]:>14.6g} {m.freq_hz[j]:>11.5g} "
-            f"{'yes' if m.rigid[j] else 'no':>5} {m.modal_mass[j]:>16.6g}"
+            f"{kind:>5} {m.modal_mass[j]:>16.6g}"
         )
         row += "".join(f" {_pct(pct[d][j]):>9}" for d in dirs)
         click.echo(row)
+    for note in m.notes:
+        click.echo(f"  note: {note}")
 
 
 def _pct(v: float) -> str:
-    return "0" if v == 0 else f"{v:.3g}"
+    """A percentage; below 1e-9 % it is the rounding of M-orthogonality, shown as 0."""
+    return "0" if abs(v) < 1e-9 else f"{v:.3g}"
 
 
 # ---- transitional: cli/locate.py still imports these two; removed when it moves to the API

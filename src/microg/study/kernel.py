@@ -245,7 +245,7 @@ def solve_basis(
     """Discretise and solve one model variant; keep ``T phi`` at the study's points.
 
     The steps and rules are those of :func:`microg.analysis.run_analysis`: ``n_modes``
-    (default :data:`microg.analysis.DEFAULT_SPARSE_MODES`) for sparse models, the rigid modes
+    (default :data:`microg.dynamics.modes.DEFAULT_N_MODES`) for sparse models, the rigid modes
     and the elastic ones up to ``max_freq_hz``, and a record too coarse for them refused.
 
     Parameters
@@ -260,7 +260,7 @@ def solve_basis(
     where : name of the record's dt in errors
     threads : BLAS threads
     """
-    from microg.analysis import DEFAULT_SPARSE_MODES
+    from microg.dynamics.modes import DEFAULT_N_MODES as DEFAULT_SPARSE_MODES
     from microg.dynamics.modes import solve_modes
     from microg.structure.discretize import discretize
 
