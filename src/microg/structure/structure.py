@@ -59,8 +59,9 @@ class Structure:
     points : mapping of str to PointMap
         The model's named points of interest.
     rigid_body : mapping of str to ndarray (n,)
-        Exact coordinate vectors of unit rigid-body motions of the whole station about the
-        reference origin: ``"x"``, ``"y"``, ``"z"`` (1 m translation) and ``"rx"``, ``"ry"``,
+        Exact coordinate vectors of unit rigid-body motions of the whole station, rotations
+        about its centre of mass (frame and modal models; the report's assumed modes turn
+        about the origin): ``"x"``, ``"y"``, ``"z"`` (1 m translation) and ``"rx"``, ``"ry"``,
         ``"rz"`` (1 rad rotation), those the discretisation can represent.  Those that ``K``
         annihilates are the exact zero-frequency modes; a rotation restrained by gravity
         gradient is not.
