@@ -106,7 +106,14 @@ class Disturbance:
 
     @property
     def unit_direction(self) -> np.ndarray:
-        """The direction used: the force's own (CSV) direction if it has one, unit length."""
+        """The direction used: the force's own (CSV) direction if it has one, unit length.
+
+        For a vector force (a direction that varies in time) it is the direction at the
+        largest force, for display; the response uses every component.
+        """
+        if self.force.is_vector:
+            vec = self.force.components()
+            return parse_direction(vec[:, int(np.argmax(np.linalg.norm(vec, axis=0)))], "force")
         d = self.force.direction if self.force.direction is not None else self.direction
         return parse_direction(np.asarray(d, float), "direction")
 
@@ -406,14 +413,18 @@ class Analysis:
 
 def _disturbance_dict(d: Disturbance) -> dict[str, Any]:
     f = d.force
+    vec = f.components(d.unit_direction)  # (3, nb), N
     direction = d.unit_direction
+    dt = np.diff(f.timepts)
+    impulse = np.sum(0.5 * (vec[:, 1:] + vec[:, :-1]) * dt, axis=1)  # trapezoids: exact (N s)
     out: dict[str, Any] = {
         "name": f.name,
         "at": d.point,
-        "direction": direction,
-        "direction_axis": axis_name(direction),
-        "peak_force_N": float(np.max(np.abs(f.force))),
-        "impulse_Ns": float(f.impulse()),
+        "direction": None if f.is_vector else direction,
+        "direction_axis": "varies (three components)" if f.is_vector else axis_name(direction),
+        "peak_force_N": float(np.max(np.linalg.norm(vec, axis=0))),
+        "impulse_Ns": float(np.linalg.norm(impulse)),
+        "impulse_Ns_axis": dict(zip("xyz", (float(v) for v in impulse), strict=True)),
         "end_s": float(f.timepts[-1]),
         "final_force_N": float(f.force[-1]),
     }
@@ -772,64 +783,98 @@ def _force_warnings(opts: AnalysisOptions) -> list[str]:
     return out
 
 
+@dataclass(frozen=True)
+class _Load:
+    """One scalar load of the response: a force history (N) through a generalized force b."""
+
+    force: ForceHistory
+    b: np.ndarray  # (n,) generalized force per newton
+    gamma: np.ndarray  # (k,) modal participation phi^T b
+
+
+def _scalar_parts(d: Disturbance) -> list[tuple[ForceHistory, np.ndarray]]:
+    """A disturbance as scalar histories along fixed unit vectors.
+
+    A scalar force is one history along its direction; a vector force (three components per
+    breakpoint, a direction that varies in time) is its x, y and z components along the
+    axes -- linear, so the response is their sum.
+    """
+    if not d.force.is_vector:
+        return [(d.force, d.unit_direction)]
+    vec = d.force.components()
+    parts = []
+    for i, axis in enumerate("xyz"):
+        if np.any(vec[i]):
+            comp = ForceHistory(d.force.timepts, vec[i], f"{d.force.name} ({axis})")
+            parts.append((comp, np.eye(3)[i]))
+    return parts
+
+
 def _modal_forces(
     structure: Structure, modes: Modes, opts: AnalysisOptions
-) -> tuple[list[np.ndarray], list[np.ndarray], list[str]]:
-    """Generalized force b and participation phi^T b of each disturbance; refuse idle forces."""
-    gammas = []
-    bs = []
+) -> tuple[list[_Load], list[str]]:
+    """The scalar loads of every disturbance; refuse a force that does no work."""
+    loads: list[_Load] = []
     warnings = []
     for i, d in enumerate(opts.disturbances):
         tmap = structure.point(d.point).translation
-        u = d.unit_direction
-        b = generalized_force_vector(tmap, u)
-        # the part of the force the model can carry: its projection on the point's motion
-        reach = np.linalg.norm(tmap @ np.linalg.pinv(tmap) @ u) if tmap.size else 0.0
-        if not np.any(b) or reach < 1e-9:
-            where = "direction" if len(opts.disturbances) == 1 else f"direction[{i}]"
-            plane = f" of the planar {structure.plane} model" if structure.plane else ""
+        where = "direction" if len(opts.disturbances) == 1 else f"direction[{i}]"
+        plane = f" of the planar {structure.plane} model" if structure.plane else ""
+        worked = False
+        for f, u in _scalar_parts(d):
+            b = generalized_force_vector(tmap, u)
+            # the part of the force the model can carry: its projection on the point's motion
+            reach = np.linalg.norm(tmap @ np.linalg.pinv(tmap) @ u) if tmap.size else 0.0
+            if not np.any(b) or reach < 1e-9:
+                if not d.force.is_vector:
+                    raise InputError(
+                        f"a force along {axis_name(u) or list(np.round(u, 6))} at {d.point!r} "
+                        f"does no work on the model{plane}: the response would be zero",
+                        where=where,
+                        fix="give a direction the model can move in"
+                        + (" (in the model's plane), or use the 3-D model" if plane else ""),
+                    )
+                warnings.append(f"{f.name} at {d.point!r} does no work on the model{plane}")
+                continue
+            if reach < 1 - 1e-9:
+                inplane = f" (its plane is {structure.plane})" if structure.plane else ""
+                warnings.append(
+                    f"only {100 * reach:.3g}% of the force {f.name!r} at {d.point!r} acts on "
+                    f"the model{inplane}; the rest is dropped"
+                )
+            loads.append(_Load(f, b, modes.phi.T @ b))
+            worked = True
+        if not worked:
             raise InputError(
-                f"a force along {axis_name(u) or list(np.round(u, 6))} at {d.point!r} does no "
-                f"work on the model{plane}: the response would be zero",
+                f"the force {d.force.name!r} at {d.point!r} does no work on the model{plane}",
                 where=where,
-                fix="give a direction the model can move in"
-                + (" (in the model's plane), or use the 3-D model" if structure.plane else ""),
+                fix="give a force the model can carry",
             )
-        if reach < 1 - 1e-9:
-            warnings.append(
-                f"only {100 * reach:.3g}% of the force {d.force.name!r} at {d.point!r} acts on "
-                f"the model{' (its plane is ' + structure.plane + ')' if structure.plane else ''}"
-                "; the rest is dropped"
-            )
-        gammas.append(modes.phi.T @ b)
-        bs.append(b)
-    return gammas, bs, warnings
+    return loads, warnings
 
 
 def _modal_acceleration(
-    m: Modes, zeta: np.ndarray, opts: AnalysisOptions, gammas: list[np.ndarray], t: np.ndarray
+    m: Modes, zeta: np.ndarray, loads: list[_Load], t: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Modal displacement, velocity, acceleration (k, nt) of all disturbances superposed."""
+    """Modal displacement, velocity, acceleration (k, nt) of all loads superposed."""
     eta = np.zeros((m.n_modes, t.size))
     vel = np.zeros_like(eta)
     acc = np.zeros_like(eta)
-    for d, g in zip(opts.disturbances, gammas, strict=True):
-        f = d.force
-        r = modal_pwl_response(m.omega, zeta, f.timepts, np.outer(g, f.force), t)
+    for ld in loads:
+        f = ld.force
+        r = modal_pwl_response(m.omega, zeta, f.timepts, np.outer(ld.gamma, f.force), t)
         eta += r.eta
         vel += r.eta_dot
         acc += r.eta_ddot
     return eta, vel, acc
 
 
-def _modal_accel_at(
-    m: Modes, zeta: np.ndarray, opts: AnalysisOptions, gammas: list[np.ndarray], pk: PeakResponse
-) -> np.ndarray:
+def _modal_accel_at(m: Modes, zeta: np.ndarray, loads: list[_Load], pk: PeakResponse) -> np.ndarray:
     """Modal accelerations (k,) at the exact peak (the limit from the left at a jump)."""
     tp = float(pk.peak_time_s)
     if pk.peak_side == "left":
         tp = float(np.nextafter(tp, -np.inf))
-    return _modal_acceleration(m, zeta, opts, gammas, np.array([tp]))[2][:, 0]
+    return _modal_acceleration(m, zeta, loads, np.array([tp]))[2][:, 0]
 
 
 def _with_exact_peak(a: Assessment, peak: PeakResponse, req: Requirement) -> Assessment:
@@ -1068,14 +1113,13 @@ def _transient(
         )
     warnings += _force_warnings(opts)
     zeta = np.where(m.rigid, 0.0, opts.zeta)
-    gammas, forces_b, w = _modal_forces(structure, m, opts)
+    loads, w = _modal_forces(structure, m, opts)
     warnings += w
     step("response")
     t = np.arange(0.0, opts.duration_s + 0.5 * opts.dt_s, opts.dt_s)
-    eta, vel, acc = _modal_acceleration(m, zeta, opts, gammas, t)
+    eta, vel, acc = _modal_acceleration(m, zeta, loads, t)
     step("assessment")
-    loads = [(d.force, b) for d, b in zip(opts.disturbances, forces_b, strict=True)]
-    peaks = peak_response(m.omega, zeta, m.phi, maps, loads, t)
+    peaks = peak_response(m.omega, zeta, m.phi, maps, [(ld.force, ld.b) for ld in loads], t)
     observations: dict[str, Observation] = {}
     mode_numbers = idx + 1
     for name, tmap in maps.items():
@@ -1083,7 +1127,7 @@ def _transient(
         resp = PointResponse(name, t, tphi @ eta, tphi @ vel, tphi @ acc)
         a = _with_exact_peak(assess(t, resp.acceleration, req), peaks[name], req)
         contrib = _contributions(
-            mode_numbers, m, tphi, acc, t, a, _modal_accel_at(m, zeta, opts, gammas, peaks[name])
+            mode_numbers, m, tphi, acc, t, a, _modal_accel_at(m, zeta, loads, peaks[name])
         )
         observations[name] = Observation(
             name=name,

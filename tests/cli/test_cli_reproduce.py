@@ -46,6 +46,7 @@ def test_files_written(tmp_path: Path, capsys) -> None:
     rc, stdout, _ = _run(capsys, ["reproduce", "--out", str(out)])
     assert rc == 0
     assert sorted(p.name for p in out.iterdir()) == [
+        ".microg-run",  # the marker of a directory microg wrote (and may replace whole)
         "figure3.png",
         "figure4.png",
         "lab-response.png",
@@ -132,17 +133,24 @@ def test_case_filter(tmp_path: Path, capsys) -> None:
     assert set(json.loads(stdout)["table4"]) == {"yz_orbiter"}
 
 
-def test_existing_directory_content_is_kept(tmp_path: Path, capsys) -> None:
-    # --out into a directory that holds other files: only microg's files are (re)written
+def test_a_directory_microg_did_not_write_is_refused(tmp_path: Path, capsys) -> None:
+    # --out into a directory that holds other files: a run replaces its directory as a whole,
+    # so a directory without microg's marker is refused, untouched, before any computation
     out = tmp_path / "mine"
     out.mkdir()
     (out / "keep.txt").write_text("precious")
     (out / "figure3.png").write_bytes(b"old")
-    rc, _, _ = _run(capsys, ["reproduce", "--out", str(out)])
-    assert rc == 0
+    rc, stdout, err = _run(capsys, ["reproduce", "--out", str(out)])
+    assert rc == 2 and stdout == "" and "--out" in err and err.count("\n") == 1
     assert (out / "keep.txt").read_text() == "precious"
-    assert (out / "figure3.png").read_bytes()[:4] == b"\x89PNG"
-    assert not [p for p in out.iterdir() if p.name.startswith(".")]  # no temporaries left
+    assert (out / "figure3.png").read_bytes() == b"old"
+    # a directory microg wrote is replaced whole, with nothing stale left beside it
+    mine = tmp_path / "run"
+    assert _run(capsys, ["reproduce", "--out", str(mine)])[0] == 0
+    (mine / "stale.png").write_bytes(b"old")
+    assert _run(capsys, ["reproduce", "--out", str(mine)])[0] == 0
+    assert not (mine / "stale.png").exists()
+    assert [p.name for p in mine.parent.iterdir() if p.name.startswith(".")] == []
 
 
 @pytest.mark.parametrize(

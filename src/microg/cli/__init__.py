@@ -77,6 +77,9 @@ def main(argv: list[str] | None = None) -> int:
         hint = f"; did you mean {', '.join(exc.possibilities)}?" if exc.possibilities else ""
         click.echo(f"microg: error: no such option {exc.option_name}{hint} (see --help)", err=True)
         return 2
+    except click.exceptions.MissingParameter as exc:
+        click.echo(f"microg: error: {_one_line(exc.format_message())} (see --help)", err=True)
+        return 2
     except click.exceptions.BadParameter as exc:
         name = exc.param.opts[0] if exc.param is not None and exc.param.opts else exc.param_hint
         click.echo(f"microg: error: {name}: {_one_line(exc.message)}", err=True)
