@@ -51,16 +51,20 @@ def test_readme_has_examples() -> None:
 @pytest.mark.slow
 @pytest.mark.parametrize("command", _readme_commands())
 def test_readme_example_runs_as_written(command: str, tmp_path: Path) -> None:
-    # run from a scratch copy of the repository root's examples/, as a user would from a clone
-    for name in ("examples",):
-        src = ROOT / name
-        if src.exists():
-            (tmp_path / name).symlink_to(src)
+    # run in a scratch directory laid out like a clone (examples/, tests/ and ../shared
+    # beside it), so that outputs land in the scratch directory, as a user's would
+    work = tmp_path / "clone"
+    work.mkdir()
+    for name in ("examples", "tests"):
+        (work / name).symlink_to(ROOT / name)
+    shared = ROOT.parent / "shared"
+    if shared.exists():
+        (tmp_path / "shared").symlink_to(shared)
     args = shlex.split(command)
     env = dict(os.environ, MPLBACKEND="Agg")
     proc = subprocess.run(
         [sys.executable, "-m", "microg", *args[1:], *(["--no-progress"] * _progress(args))],
-        cwd=tmp_path,
+        cwd=work,
         capture_output=True,
         text=True,
         timeout=600,
