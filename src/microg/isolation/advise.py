@@ -137,7 +137,7 @@ class IsolationAdvice:
                 "k1_N_per_m": d.k1,
                 "k1_lbf_per_in": d.k1_lbf_per_in,
                 "omega_n": d.omega_n,
-                "freq_hz_n": d.freq_hz_n,
+                "natural_freq_hz": d.freq_hz_n,
                 "achieved_Ma": d.achieved_Ma,
                 "sag_1g_m": d.sag_1g,
                 "mu": d.mu,
@@ -151,7 +151,7 @@ class IsolationAdvice:
                 "k1_lbf_per_in": mc.k1 * IN / LBF,
                 "zeta1": mc.zeta1,
                 "c1_N_s_per_m": mc.c1,
-                "freq_hz_n": mc.freq_hz_n,
+                "natural_freq_hz": mc.freq_hz_n,
                 "screen_min_margin": mc.min_margin,
                 "screened": mc.screened,
             }
