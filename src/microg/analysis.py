@@ -38,8 +38,6 @@ from microg.environment.metrics import Assessment, acceleration_psd, assess, ban
 from microg.environment.requirements import (
     BandTable,
     Requirement,
-    iss_requirement,
-    report_flat_requirement,
 )
 from microg.errors import InputError
 from microg.isolation.advise import IsolationAdvice, advise_isolation
@@ -426,7 +424,7 @@ def _disturbance_dict(d: Disturbance) -> dict[str, Any]:
         "impulse_Ns": float(np.linalg.norm(impulse)),
         "impulse_Ns_axis": dict(zip("xyz", (float(v) for v in impulse), strict=True)),
         "end_s": float(f.timepts[-1]),
-        "final_force_N": float(f.force[-1]),
+        "final_force_N": float(np.linalg.norm(vec[:, -1])),
     }
     params = getattr(f, "params", None)
     if params:
@@ -538,10 +536,8 @@ def _check_points(names: Sequence[str], known: Sequence[str], where: str) -> Non
 
 def _load(model: Any) -> Any:
     if isinstance(model, str | Path):
-        try:
-            from microg.models.load import load_model
-        except ImportError:
-            from microg.models.toml import load_station as load_model
+        from microg.models.load import load_model
+
         return load_model(model)
     return model
 
@@ -558,19 +554,12 @@ def _sources(sources: Any) -> Any:
 
 
 def _requirement(name: str | Requirement) -> Requirement:
+    """A requirement object, or the one of that name (``iss``, ``ssp41000``, ``flat``)."""
     if isinstance(name, Requirement):
         return name
-    try:
-        from microg.environment.requirements import requirement as by_name
-    except ImportError:
-        by_name = None
-    if by_name is not None:
-        return by_name(name)
-    if name == "iss":
-        return iss_requirement()
-    if name in ("flat", "report-1e-5g"):
-        return report_flat_requirement()
-    raise InputError(f"unknown requirement {name!r}", where="requirement", fix="use iss or flat")
+    from microg.environment.requirements import requirement as by_name
+
+    return by_name(name)
 
 
 def analyze(
@@ -770,8 +759,9 @@ def _force_warnings(opts: AnalysisOptions) -> list[str]:
     out = []
     for d in opts.disturbances:
         f = d.force
-        last = float(f.force[-1])
-        peak = float(np.max(np.abs(f.force)))
+        vec = f.components(d.unit_direction)
+        last = float(np.linalg.norm(vec[:, -1]))
+        peak = float(np.max(np.linalg.norm(vec, axis=0)))
         if peak > 0 and abs(last) > 1e-9 * peak:
             impulse = f.impulse() + last * (opts.duration_s - f.timepts[-1])
             out.append(
@@ -862,7 +852,7 @@ def _modal_acceleration(
     acc = np.zeros_like(eta)
     for ld in loads:
         f = ld.force
-        r = modal_pwl_response(m.omega, zeta, f.timepts, np.outer(ld.gamma, f.force), t)
+        r = modal_pwl_response(m.omega, zeta, f.timepts, np.outer(ld.gamma, f.values), t)
         eta += r.eta
         vel += r.eta_dot
         acc += r.eta_ddot
@@ -1078,11 +1068,13 @@ def _transient(
 ) -> tuple[dict[str, Observation], np.ndarray, list[str]]:
     """The transient regime: exact response, assessment, exact peaks, isolation advice."""
     warnings: list[str] = []
-    if np.any(modes.unstable):
-        k = int(np.flatnonzero(modes.unstable)[0])
+    if np.any(np.asarray(modes.unstable, bool)):
+        unstable = np.asarray(modes.unstable, bool)
+        growth = np.asarray(modes.growth_rate, float)
+        k = int(np.flatnonzero(unstable)[0])
         note = next((n for n in modes.notes if "unstable" in n), "")
         raise InputError(
-            f"mode {k + 1} is unstable (growth rate {modes.growth_rate[k]:.3g} rad/s): the "
+            f"mode {k + 1} is unstable (growth rate {growth[k]:.3g} rad/s): the "
             f"transient response grows without bound, so no verdict can be drawn. {note}",
             where="gravity_gradient",
             fix="analyse the free-free structure (no gravity gradient), or correct the inertias",

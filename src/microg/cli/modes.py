@@ -129,6 +129,8 @@ def modes(
     (zero for the elastic modes of a free-free structure, which are M-orthogonal to the rigid
     motions; non-zero where gravity gradient restrains a rotation).
     """
+    import numpy as np
+
     import microg
     from microg._io import dumps
     from microg.cli._errors import flag_errors
@@ -156,8 +158,9 @@ def modes(
         if fem_plane:
             from microg.dynamics.planar import in_plane_modes
 
-            ask = min(max(3 * (want or 20), (want or 20) + 6), structure.n_dof)
-            m = in_plane_modes(structure, microg.solve_modes(structure, n_modes=ask), plane, want)
+            count = want or _default_modes()
+            ask = min(max(3 * count, count + 6), structure.n_dof)
+            m = in_plane_modes(structure, microg.solve_modes(structure, n_modes=ask), plane, count)
         else:
             m = microg.solve_modes(structure, n_modes=want)
         if uff_out is not None:
@@ -187,8 +190,9 @@ def modes(
     head = f"{'#':>3} {'omega (rad/s)':>14} {'f (Hz)':>11} {'rigid':>5} {'modal mass (kg)':>16}"
     head += "".join(f" {'eff ' + d + ' %':>9}" for d in dirs)
     click.echo(head)
+    unstable = np.asarray(m.unstable, bool)
     for j in range(m.n_modes):
-        kind = "yes" if m.rigid[j] else ("UNST" if m.unstable[j] else "no")
+        kind = "yes" if m.rigid[j] else ("UNST" if unstable[j] else "no")
         row = (
             f"{j + 1:>3} {m.omega[j]:>14.6g} {m.freq_hz[j]:>11.5g} "
             f"{kind:>5} {m.modal_mass[j]:>16.6g}"

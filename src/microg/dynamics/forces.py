@@ -148,6 +148,12 @@ class ForceHistory:
             object.__setattr__(self, "direction", _readonly(d))
 
     @property
+    def values(self) -> np.ndarray:
+        """The force at each breakpoint, (nb,), N: ``force``, never None after construction."""
+        assert self.force is not None  # __post_init__ sets it (the magnitude for a vector)
+        return self.force
+
+    @property
     def is_vector(self) -> bool:
         """True when the direction varies in time (the history carries ``vector``)."""
         return self.vector is not None

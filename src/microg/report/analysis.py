@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import re
 from typing import TYPE_CHECKING
 
 from microg._io import to_jsonable
@@ -15,23 +14,9 @@ __all__ = ["figure_names", "figures", "render_analysis"]
 
 def figure_names(names: list[str]) -> dict[str, str]:
     """Unique, stable file-name stems for point names (``a/b`` and ``a_b`` never collide)."""
-    try:
-        from microg._io import safe_filenames
-    except ImportError:
-        safe_filenames = None
-    if safe_filenames is not None:
-        return dict(safe_filenames(names))
-    out: dict[str, str] = {}
-    taken: set[str] = set()
-    for name in names:
-        stem = re.sub(r"[^A-Za-z0-9_-]", "_", name) or "point"
-        base, k = stem, 2
-        while stem.lower() in taken:
-            stem = f"{base}-{k}"
-            k += 1
-        taken.add(stem.lower())
-        out[name] = stem
-    return out
+    from microg._io import safe_filenames
+
+    return dict(safe_filenames(names))
 
 
 def figures(result: Analysis) -> dict[str, bytes]:
