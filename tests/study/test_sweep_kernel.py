@@ -175,3 +175,69 @@ def test_every_case_of_the_plan_is_computed(data, result) -> None:
     assert np.all(np.isfinite(data.peak_accel_g.values))
     assert data.band_rms_g.dims == (*CASE_DIMS, "axis", "band")
     assert data.band_rms_g.attrs["units"] == "g"
+
+
+CATALOGUE = """
+[study]
+model = "ioc"
+[axes]
+force = ["foot-pushoff-max", "sources:example"]
+at = ["crew", "vertical-lab"]
+direction = ["x", "y"]
+observe = ["lab", "keel-tip"]
+damping = [0.005, 0.02]
+[record]
+duration = "40 s"
+dt = "0.1 s"
+max_freq = "2 Hz"
+"""
+
+
+def test_a_source_catalogue_case_equals_analyze_with_sources() -> None:
+    """A catalogue is assessed in the frequency domain (microg.analyze(sources=...)); its
+    sources carry their own points, so every at/direction holds the same values."""
+    r = sweep(loads_study(CATALOGUE, filename="study.toml"))
+    ds = r.dataset.load()
+    cat = ds.sel(force="sources:example")
+    assert bool(cat.computed.all()) and bool(np.isnan(cat.peak_accel_g).all())
+    for iz, io in ((0, 0), (1, 1)):
+        index = (0, 0, 0, iz, 1, 1, 0, io)
+        labels = r.study.case(index)
+        fd = r.analyze_case(labels).frequency_domain  # the per-case path, alone
+        point = ds.isel(dict(zip(CASE_DIMS, index, strict=True)))
+        nb = point.band.size
+        assert np.array_equal(point.band.values, fd.center_hz[:nb])
+        _close(point.band_rms_g.values, fd.rms_g[0][:, :nb], float(fd.rms_g.max()))
+        _close(point.margin.values, np.min(fd.margin[0]), 1.0)
+        assert bool(point.complies.values) == bool(fd.complies[0])
+        same = ds.band_rms_g.isel(model=0, variant=0, isolator=0, damping=iz, force=1,
+                                  observe=io).values  # fmt: skip
+        assert np.all(same == same[0, 0])  # at and direction do not apply to a catalogue
+    # the time-domain force of the same study still equals analyze (with the modes the
+    # study's solve asked for: the analysis' count with sources)
+    index = (0, 0, 0, 0, 0, 1, 1, 1)
+    labels = r.study.case(index)
+    a = r.analyze_case(labels, isolation=False).observations[labels["observe"]].assessment
+    point = ds.isel(dict(zip(CASE_DIMS, index, strict=True)))
+    _close(point.peak_accel_g.values, a.peak_accel_g, a.peak_accel_g)
+    _close(point.band_rms_g.values, a.third_octave.rms_g, float(a.third_octave.rms_g.max()))
+    from microg.study.summary import case_command
+
+    cmd = case_command(r, r.study.case((0, 0, 0, 0, 1, 0, 0, 0)))
+    assert cmd is not None and "--sources example" in cmd and "--force" not in cmd
+
+
+def test_a_catalogue_is_refused_with_an_isolator_or_undamped_modes() -> None:
+    from microg.errors import InputError
+
+    iso = CATALOGUE.replace("[record]", '[[axes.isolator]]\nname = "soft"\nf_n = "0.1 Hz"\n'
+                            "[record]")  # fmt: skip
+    with pytest.raises(InputError) as info:
+        loads_study(iso, filename="s.toml")
+    assert info.value.where == "s.toml: axes.isolator"
+    with pytest.raises(InputError) as info:
+        loads_study(CATALOGUE.replace("[0.005, 0.02]", "[0.0, 0.02]"), filename="s.toml")
+    assert info.value.where == "s.toml: axes.damping[0]"
+    with pytest.raises(InputError) as info:
+        loads_study(CATALOGUE.replace("sources:example", "sources:nope.toml"), filename="s.toml")
+    assert info.value.where == "s.toml: axes.force[1]"

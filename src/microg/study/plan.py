@@ -289,17 +289,21 @@ class IsolatorItem:
 
 @dataclass(frozen=True)
 class ForceItem:
-    """One force of the ``force`` axis: a spec as written and its history (s, N).
+    """One value of the ``force`` axis: a spec as written, and what it is.
 
-    ``kind`` is ``"time"`` (a piecewise-linear history: library activity, spec, CSV file).  It
-    is the extension point for frequency-domain source catalogues (a future ``"catalogue"``
-    kind, see ``docs/scale.md``).
+    ``kind`` is ``"time"`` (``history``: a piecewise-linear force, s and N: a library activity,
+    a spec, a CSV file; it acts at the case's point along its direction) or ``"catalogue"``
+    (``catalogue``: a frequency-domain source catalogue, ``sources:FILE``, whose sources carry
+    their own points and directions, assessed by
+    :func:`microg.environment.vibratory.assess_sources`; the ``at`` and ``direction`` axes do
+    not apply to it).
     """
 
     label: str
     spec: str
-    history: ForceHistory = field(repr=False)
+    history: ForceHistory | None = field(default=None, repr=False)
     kind: str = "time"
+    catalogue: Any = field(default=None, repr=False)
 
 
 @dataclass(frozen=True)
@@ -485,8 +489,12 @@ class Study:
         for m in (*self.models, *(v.model for v in self.variants if v.model is not None)):
             h.update(b"\0" + _model_digest(m).encode())
         for f in self.forces:
-            h.update(b"\0" + f.label.encode() + np.asarray(f.history.timepts).tobytes())
-            h.update(np.asarray(f.history.force).tobytes())
+            h.update(b"\0" + f.label.encode())
+            if f.history is not None:
+                h.update(np.asarray(f.history.timepts).tobytes())
+                h.update(np.asarray(f.history.force).tobytes())
+            else:
+                h.update(repr(f.catalogue.to_dict()).encode())
         return h.hexdigest()
 
     # ------------------------------------------------------------------ models
@@ -800,6 +808,7 @@ class _Builder:
             )
         self.check_points(study)
         self.check_record(study)
+        self.check_catalogues(study)
         return study
 
     def unique(self, labels: Sequence[Any], path: str, fix: str) -> None:
@@ -986,6 +995,9 @@ class _Builder:
         for i, spec in enumerate(specs):
             path = f"axes.force[{i}]" if raw is not None else "axes.force"
             head = spec.partition(":")[0].strip().lower()
+            if head == "sources":
+                out.append(self.catalogue(spec, path))
+                continue
             resolved = spec
             if head not in lib:
                 p = Path(spec)
@@ -1010,6 +1022,20 @@ class _Builder:
             out.append(ForceItem(spec, resolved, hist))
         self.unique([f.label for f in out], "axes.force", "list each force once")
         return tuple(out)
+
+    def catalogue(self, spec: str, path: str) -> ForceItem:
+        from microg.environment.sources import load_sources
+
+        name = spec.partition(":")[2].strip()
+        if not name:
+            raise self.err(path, "no catalogue file after sources:", 'write "sources:FILE.toml"')
+        p = Path(name)
+        resolved = name if name == "example" else str(p if p.is_absolute() else self.base / p)
+        try:
+            cat = load_sources(resolved)
+        except InputError as exc:
+            raise self.rewrap(exc, path) from None
+        return ForceItem(spec, resolved, None, "catalogue", cat)
 
     def damping(self, raw: Sequence[float] | None) -> tuple[float, ...]:
         self.empty(raw, "damping")
@@ -1101,9 +1127,48 @@ class _Builder:
                                 f"known points: {', '.join(known)}; or declare it in [[point]]",
                             )
 
+    def check_catalogues(self, study: Study) -> None:
+        """A catalogue needs damped modes, no isolator, and its points in every model."""
+        from microg.environment.sources import validate_source_points
+
+        cats = [i for i, f in enumerate(study.forces) if f.kind == "catalogue"]
+        if not cats:
+            return
+        sets = study.case_sets or (tuple(tuple(range(n)) for n in study.shape),)
+        for k, cs in enumerate(sets):
+            used = [i for i in cs[4] if i in cats]
+            if not used:
+                continue
+            where = f"case[{k}]" if study.case_sets else "axes"
+            if any(study.isolators[i].mount is not None for i in cs[2]):
+                raise self.err(
+                    f"{where}.isolator" if study.case_sets else "axes.isolator",
+                    "a source catalogue is assessed in the frequency domain without an isolator",
+                    'list the catalogue\'s cases with [[case]] isolator = "none"',
+                )
+            for j in cs[3]:
+                if not study.damping[j] > 0:
+                    raise self.err(
+                        f"axes.damping[{j}]",
+                        "a source catalogue needs damped modes (an undamped resonance inside a "
+                        "band has an infinite band integral)",
+                        "use damping > 0 for its cases",
+                    )
+            for im in set(cs[0]):
+                for iv in set(cs[1]):
+                    model = study.variant_model(im, iv)
+                    names = [p for p, _ in _point_names(model)]
+                    for i in used:
+                        try:
+                            validate_source_points(study.forces[i].catalogue.sources, names)
+                        except InputError as exc:
+                            raise self.rewrap(exc, f"axes.force[{i}]") from None
+
     def check_record(self, study: Study) -> None:
         rec = study.record
         for i, f in enumerate(study.forces):
+            if f.history is None:
+                continue
             end = float(f.history.timepts[-1])
             if end > rec.duration_s:
                 raise self.err(

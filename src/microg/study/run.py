@@ -151,7 +151,10 @@ class SweepResult:
         return self.study.variant_model(im, iv)
 
     def analyze_case(self, case: dict[str, Any], **kwargs: Any) -> Any:
-        """Run :func:`microg.analyze` on one case alone (the per-case path), no isolator.
+        """Run the per-case path on one case alone, no isolator.
+
+        :func:`microg.analyze` for a force history; for a source catalogue,
+        :func:`microg.environment.vibratory.assess_sources` on the variant's modes.
 
         Parameters
         ----------
@@ -164,6 +167,24 @@ class SweepResult:
         f = s.forces[s.coords["force"].index(case["force"])]
         d = s.directions[s.coords["direction"].index(case["direction"])]
         disc, rec = s.discretisation, s.record
+        n_modes = disc.n_modes or _n_modes(s)
+        if f.catalogue is not None:
+            return analyze(
+                self.case_model(case["model"], case["variant"]),
+                sources=f.catalogue,
+                observe=[case["observe"]],
+                method=disc.method,
+                plane=disc.plane,
+                n=disc.n,
+                n_modes=n_modes,
+                gravity_gradient=disc.gravity_gradient,
+                damping=float(case["damping"]),
+                duration=rec.duration_s,
+                dt=rec.dt_s,
+                max_freq=rec.max_freq_hz,
+                requirement=rec.requirement,
+                **kwargs,
+            )
         return analyze(
             self.case_model(case["model"], case["variant"]),
             force=f.spec,
@@ -173,7 +194,7 @@ class SweepResult:
             method=disc.method,
             plane=disc.plane,
             n=disc.n,
-            n_modes=disc.n_modes,
+            n_modes=n_modes,
             gravity_gradient=disc.gravity_gradient,
             damping=float(case["damping"]),
             duration=rec.duration_s,
@@ -185,6 +206,17 @@ class SweepResult:
 
 
 # ----------------------------------------------------------------------------- planning
+
+
+def _n_modes(study: Study) -> int | None:
+    """The modes a sparse model's solve asks for when the study names none: the analysis'
+    default, or its default with sources when the study has source catalogues (so that the
+    per-case path solves the same modes)."""
+    if not any(f.catalogue is not None for f in study.forces):
+        return None
+    from microg.analysis import DEFAULT_SOURCE_MODES
+
+    return int(DEFAULT_SOURCE_MODES)
 
 
 def _tasks(study: Study, blocks: Sequence[Block]) -> dict[tuple[int, int], list[list[BlockWork]]]:
@@ -221,13 +253,22 @@ def _solve_args(study: Study, im: int, iv: int) -> tuple[Any, dict[str, Any]]:
         "observe": study.observe,
         "directions": np.array([x.vector for x in study.directions], float),
         "where": f"{study.file}: record.dt",
+        "catalogues": [
+            (i_f, i_z, f.catalogue, study.damping[i_z])
+            for i_f, f in enumerate(study.forces)
+            if f.catalogue is not None
+            for i_z in range(len(study.damping))
+            if study.damping[i_z] > 0
+        ],
+        "requirement": r.requirement,
     }
 
 
 def _check_reach(study: Study, basis: Basis) -> list[str]:
     """Refuse a force the model cannot carry (as the analysis does); warn of a partial one."""
     bad = np.argwhere(basis.reach < 1e-9)
-    if bad.size and not all(f.history.direction is not None for f in study.forces):
+    own = [f.history is None or f.history.direction is not None for f in study.forces]
+    if bad.size and not all(own):
         ia, idr = (int(x) for x in bad[0])
         raise InputError(
             f"a force along {study.directions[idr].label!r} at {study.at[ia]!r} does no work on "

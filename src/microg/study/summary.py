@@ -121,7 +121,8 @@ def _num(v: float) -> float | str | None:
 def _sort_key(row: dict[str, Any]) -> tuple[float, float]:
     m = row["margin"]
     key = -np.inf if m is None else (np.inf if m == "inf" else float(m))
-    return (key, -float(row["peak_accel_g"] or 0.0))
+    peak = row["peak_accel_g"]
+    return (key, -(peak if isinstance(peak, float) and np.isfinite(peak) else 0.0))
 
 
 def default_heatmap(study: Study) -> tuple[str, str]:
@@ -302,13 +303,21 @@ def _case_row(result: SweepResult, ds: Any, case: tuple[int, ...]) -> dict[str, 
     }
 
 
-def _model_ref(result: SweepResult, labels: dict[str, Any]) -> tuple[str | None, str]:
-    """(path for ``microg analyze``, or None when the CLI cannot load it; Python expression)."""
+def _items(result: SweepResult, labels: dict[str, Any]) -> tuple[Any, Any]:
+    """The model item (the variant's file, or the study's model) and the variant of a case."""
     study = result.study
     im = study.coords["model"].index(labels["model"])
     iv = study.coords["variant"].index(labels["variant"])
     m, v = study.models[im], study.variants[iv]
     item = v.model if v.kind == "model" and v.model is not None else m
+    return item, v
+
+
+def _model_ref(result: SweepResult, labels: dict[str, Any]) -> tuple[str | None, str]:
+    """(path for ``microg analyze``, or None when the CLI cannot load it; Python expression)."""
+    study = result.study
+    m = study.models[study.coords["model"].index(labels["model"])]
+    item, v = _items(result, labels)
     if v.kind == "move" or item.derived:
         written = None
         if result.out is not None:
@@ -320,7 +329,7 @@ def _model_ref(result: SweepResult, labels: dict[str, Any]) -> tuple[str | None,
             f"microg.models.load.load_model({item.path!r}, units={item.units!r}, "
             f"points={item.points!r})"
         )
-        return None, expr
+        return item.path, expr
     return item.path, repr(item.path)
 
 
@@ -335,49 +344,64 @@ def model_file(model: str, variant: str) -> str:
 def case_command(result: SweepResult, labels: dict[str, Any]) -> str | None:
     """The ``microg analyze`` command line that reproduces one case alone (no isolator).
 
-    None when the command line cannot express the case (a modal file needing units, or the
-    gravity-gradient option): :func:`case_python` always can.
+    A source catalogue's case is ``microg analyze --sources FILE``.  None when the model
+    cannot be named on a command line (an in-memory study): :func:`case_python` always can.
     """
     study = result.study
     path, _ = _model_ref(result, labels)
     d, r = study.discretisation, study.record
-    if path is None or d.gravity_gradient:
-        return None
     force = study.forces[study.coords["force"].index(labels["force"])]
+    if path is None:
+        return None
     direc = study.directions[study.coords["direction"].index(labels["direction"])]
-    dtext = (
-        direc.label
-        if direc.label.lstrip("+-") in ("x", "y", "z")
-        else " ".join(repr(float(x)) for x in direc.vector)
-    )
-    args = ["microg", "analyze", path, "--force", force.spec, "--at", labels["at"],
-            "--direction", dtext, "--observe", labels["observe"],
-            "--damping", repr(float(labels["damping"])), "--method", d.method]  # fmt: skip
+    axis = direc.label.lstrip("+-") in ("x", "y", "z")
+    dtext = direc.label if axis else " ".join(repr(float(x)) for x in direc.vector)
+    item, _ = _items(result, labels)
+    args = ["microg", "analyze", path]
+    if item.units is not None:
+        args += ["--units", item.units]
+    if item.points is not None:
+        args += ["--points", item.points]
+    if force.catalogue is not None:
+        args += ["--sources", force.spec]
+    else:
+        args += ["--force", force.spec, "--at", labels["at"], "--direction", dtext]
+    args += ["--observe", labels["observe"], "--damping", repr(float(labels["damping"]))]
+    args += ["--method", d.method]
     if d.method == "ritz":
         args += ["--plane", d.plane]
     if d.n is not None:
         args += ["--elements", str(d.n)]
-    if d.n_modes is not None:
-        args += ["--n-modes", str(d.n_modes)]
-    args += [
-        "--max-freq", f"{r.max_freq_hz!r} Hz", "--duration", f"{r.duration_s!r} s",
-        "--dt", f"{r.dt_s!r} s", "--requirement", _CLI_REQUIREMENT.get(r.requirement, "iss"),
-    ]  # fmt: skip
+    from microg.study.run import _n_modes
+
+    n_modes = d.n_modes or _n_modes(study)
+    if n_modes is not None:
+        args += ["--n-modes", str(n_modes)]
+    if d.gravity_gradient:
+        args += ["--gravity-gradient"]
+    args += ["--max-freq", f"{r.max_freq_hz!r} Hz", "--duration", f"{r.duration_s!r} s"]
+    args += ["--dt", f"{r.dt_s!r} s", "--requirement", _CLI_REQUIREMENT.get(r.requirement, "iss")]
     return " ".join(shlex.quote(a) for a in args)
 
 
 def case_python(result: SweepResult, labels: dict[str, Any]) -> str:
     """The Python call that reproduces one case alone with :func:`microg.analyze`."""
+    from microg.study.run import _n_modes
+
     study = result.study
     _, model = _model_ref(result, labels)
     d, r = study.discretisation, study.record
     force = study.forces[study.coords["force"].index(labels["force"])]
     direc = study.directions[study.coords["direction"].index(labels["direction"])]
+    if force.catalogue is not None:
+        what = f"sources={force.spec!r}"
+    else:
+        vec = [float(x) for x in direc.vector]
+        what = f"force={force.spec!r}, at={labels['at']!r}, direction={vec!r}"
     return (
-        f"microg.analyze({model}, force={force.spec!r}, at={labels['at']!r}, "
-        f"direction={[float(x) for x in direc.vector]!r}, observe=[{labels['observe']!r}], "
+        f"microg.analyze({model}, {what}, observe=[{labels['observe']!r}], "
         f"damping={float(labels['damping'])!r}, method={d.method!r}, plane={d.plane!r}, "
-        f"n={d.n!r}, n_modes={d.n_modes!r}, gravity_gradient={d.gravity_gradient!r}, "
-        f"max_freq={r.max_freq_hz!r}, duration={r.duration_s!r}, dt={r.dt_s!r}, "
-        f"requirement={r.requirement!r})"
+        f"n={d.n!r}, n_modes={d.n_modes or _n_modes(study)!r}, "
+        f"gravity_gradient={d.gravity_gradient!r}, max_freq={r.max_freq_hz!r}, "
+        f"duration={r.duration_s!r}, dt={r.dt_s!r}, requirement={r.requirement!r})"
     )
