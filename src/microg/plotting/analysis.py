@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from matplotlib.figure import Figure
 
+from microg.plotting.common import envelope, finish, new_figure
 from microg.units import G0
 
 if TYPE_CHECKING:
@@ -113,7 +114,7 @@ def model_figure(
     views = _views(pos)
     size = float(np.max(np.ptp(pos, axis=0))) if pos.size else 1.0
     ncol = max(len(elastic), 2)
-    fig = Figure(figsize=(7.8, 7.6), layout="constrained")
+    fig = new_figure(7.8, 7.6)
     grid = fig.add_gridspec(2, ncol * 2)
     names = "xyz"
     for col, (h, v) in enumerate(views):
@@ -168,12 +169,12 @@ def model_figure(
         ax.set_title(f"mode {j + 1}: {modes.freq_hz[j]:.3g} Hz ({names[h]}-{names[v]})", fontsize=9)
         ax.set_xticks([])
         ax.set_yticks([])
-    return fig
+    return finish(fig, left=0.75, right=0.15, bottom=0.1, top=0.3, hspace=0.85, wspace=0.85)
 
 
 def force_figure(disturbances: list[Any], duration_s: float) -> Figure:
     """Each force history f(t) over the record (N), from its breakpoints."""
-    fig = Figure(figsize=(7.5, 3.2), layout="constrained")
+    fig = new_figure(7.5, 3.2)
     ax = fig.subplots()
     for d in disturbances:
         f = d.force
@@ -185,12 +186,12 @@ def force_figure(disturbances: list[Any], duration_s: float) -> Figure:
     ax.set_title("Disturbances")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)
-    return fig
+    return finish(fig)
 
 
 def modes_figure(result: Analysis) -> Figure:
     """Frequencies of the computed modes, numbered as in the modes table, used ones filled."""
-    fig = Figure(figsize=(7.5, 3.6), layout="constrained")
+    fig = new_figure(7.5, 3.6)
     ax = fig.subplots()
     m = result.modes
     num = np.arange(1, m.n_modes + 1)
@@ -204,7 +205,7 @@ def modes_figure(result: Analysis) -> Figure:
     ax.set_title(f"Modes of {result.model} ({m.n_rigid} rigid-body modes at 0 Hz, not drawn)")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
-    return fig
+    return finish(fig)
 
 
 def live_axes(accel: np.ndarray) -> list[int]:
@@ -223,10 +224,10 @@ def observation_figure(ob: Observation) -> Figure:
     r = ob.response
     a = ob.assessment
     live = live_axes(r.acceleration)
-    fig = Figure(figsize=(7.5, 6.4), layout="constrained")
+    fig = new_figure(7.5, 6.4)
     ax1, ax2 = fig.subplots(2, 1)
     for i in live:
-        ax1.plot(r.timepts, r.acceleration[i] * _UG, lw=0.8, label="xyz"[i])
+        ax1.plot(*envelope(r.timepts, r.acceleration[i] * _UG), lw=0.8, label="xyz"[i])
     ax1.set_xlabel("time [s]")
     ax1.set_ylabel("acceleration [micro-g]")
     ax1.set_title(f"Acceleration at {ob.name} (peak {a.peak_accel_g:.3g} g)")
@@ -243,7 +244,7 @@ def observation_figure(ob: Observation) -> Figure:
     ax2.set_ylabel("band RMS [micro-g]")
     ax2.grid(True, which="both", alpha=0.3)
     ax2.legend(fontsize=8)
-    return fig
+    return finish(fig, hspace=0.65)
 
 
 def isolation_figure(ob: Observation) -> Figure:
@@ -251,26 +252,26 @@ def isolation_figure(ob: Observation) -> Figure:
     adv = ob.isolation
     pkg = adv.package_accel
     r = ob.response
-    fig = Figure(figsize=(7.5, 3.8), layout="constrained")
+    fig = new_figure(7.5, 3.8)
     ax = fig.subplots()
     axis = int(np.argmax(np.max(np.abs(r.acceleration), axis=1)))
-    ax.plot(r.timepts, r.acceleration[axis] * _UG, lw=0.8, label="mount (station)")
+    ax.plot(*envelope(r.timepts, r.acceleration[axis] * _UG), lw=0.8, label="mount (station)")
     if pkg is not None:
         label = "isolated package" + ("" if adv.recommended else " (mount NOT recommended)")
-        ax.plot(r.timepts, pkg[axis] * _UG, lw=0.9, label=label)
+        ax.plot(*envelope(r.timepts, pkg[axis] * _UG), lw=0.9, label=label)
     ax.set_xlabel("time [s]")
     ax.set_ylabel(f"acceleration, {'xyz'[axis]} [micro-g]")
     ax.set_title(f"Isolation check at {ob.name}: {adv.status}")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)
-    return fig
+    return finish(fig)
 
 
 def analysis_figure(result: Analysis) -> Figure:
     """Peak acceleration at each observed point against the report's 1e-5 g."""
     from microg.analysis import REPORT_LIMIT_G
 
-    fig = Figure(figsize=(7.5, 3.4), layout="constrained")
+    fig = new_figure(7.5, 3.4)
     ax = fig.subplots()
     names = list(result.observations)
     peaks = [result.observations[n].peak_accel_g for n in names]
@@ -281,4 +282,4 @@ def analysis_figure(result: Analysis) -> Figure:
     ax.set_ylabel("peak acceleration [g]")
     ax.set_title("Peak at each observed point (green: band verdict complies)")
     ax.legend(fontsize=8)
-    return fig
+    return finish(fig)

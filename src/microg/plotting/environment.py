@@ -19,6 +19,7 @@ from microg.environment.metrics import (
     _as_axes,
     integrated_acceleration,
 )
+from microg.plotting.common import envelope, finish, new_figure
 from microg.units import G0
 
 __all__ = [
@@ -32,7 +33,7 @@ __all__ = [
 
 
 def _figure(title: str) -> tuple[Figure, Any]:
-    fig = Figure(figsize=(7.5, 4.5), layout="constrained")
+    fig = new_figure(7.5, 4.5)
     ax = fig.add_subplot()
     if title:
         ax.set_title(title)
@@ -59,12 +60,12 @@ def plot_time_history(
     fig, ax = _figure(title or "Acceleration")
     a = _as_axes(accel) / G0 * 1e6
     for name, row in zip(axes, a, strict=False):
-        ax.plot(timepts, row, label=name, lw=0.8)
+        ax.plot(*envelope(timepts, row), label=name, lw=0.8)
     ax.set_xlabel("time [s]")
     ax.set_ylabel("acceleration [micro-g]")
     ax.grid(True, alpha=0.3)
     ax.legend()
-    return fig
+    return finish(fig)
 
 
 def plot_psd(
@@ -81,7 +82,7 @@ def plot_psd(
     ax.set_ylabel("PSD [g^2/Hz]")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
-    return fig
+    return finish(fig)
 
 
 def _bands_on(ax: Any, to: ThirdOctave, axes: tuple[str, ...], style: str, label: str) -> None:
@@ -121,7 +122,7 @@ def plot_third_octave(assessment: Assessment, *, title: str = "") -> Figure:
     ax.set_ylabel("band RMS [micro-g]")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
-    return fig
+    return finish(fig)
 
 
 def plot_integrated_acceleration(
@@ -136,12 +137,12 @@ def plot_integrated_acceleration(
     integ = integrated_acceleration(timepts, accel, window_s)
     fig, ax = _figure(title or f"Integrated acceleration, sliding {integ.window_s:g}-s windows")
     for name, row in zip(axes, integ.delta_v, strict=False):
-        ax.plot(integ.t_start, row, label=name, lw=0.8)
+        ax.plot(*envelope(integ.t_start, row), label=name, lw=0.8)
     ax.set_xlabel("window start [s]")
     ax.set_ylabel("integral of acceleration [m/s]")
     ax.grid(True, alpha=0.3)
     ax.legend()
-    return fig
+    return finish(fig)
 
 
 def plot_overlay(
@@ -156,7 +157,7 @@ def plot_overlay(
     Top: 1/3-octave band RMS of both (solid: the first, dashed: the second) against the
     first's requirement steps.  Bottom: their PSDs, worst axis by RMS, in g^2/Hz.
     """
-    fig = Figure(figsize=(7.5, 7.0), layout="constrained")
+    fig = new_figure(7.5, 7.0)
     ax1, ax2 = fig.subplots(2, 1)
     ax1.set_title(title or f"{labels[0]} and {labels[1]} vs {prediction.requirement}")
     _bands_on(ax1, prediction.third_octave, prediction.axes, "o-", f"{labels[0]} ")
@@ -184,4 +185,4 @@ def plot_overlay(
     ax2.set_ylabel("PSD [g^2/Hz]")
     ax2.grid(True, which="both", alpha=0.3)
     ax2.legend(fontsize=8)
-    return fig
+    return finish(fig, hspace=0.65)
