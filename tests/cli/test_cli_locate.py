@@ -5,12 +5,14 @@ from __future__ import annotations
 import json
 import re
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from microg.cli import main
 from microg.dynamics.crew import CrewPushoff
+from microg.dynamics.forces import REPORT_F0_N
 from microg.dynamics.modes import solve_modes
 from microg.location.amap import acceleration_map, locate
 from microg.models.toml import load_station
@@ -322,3 +324,74 @@ def test_progress_bar_on_a_tty_only(capsys, monkeypatch):
     assert rc == 0 and "microg optimize" in err
     rc, out, err = _run(capsys, *args, "--no-progress")
     assert rc == 0 and err == ""
+
+
+# --------------------------------------------------------------------------- imported models
+
+
+@pytest.fixture(scope="module")
+def ioc_uff(tmp_path_factory):
+    """The IOC FE modes written as UFF (double) with a points file naming the crew grid."""
+    from microg.models.uff import write_uff_modes
+
+    s = discretize(load_station("ioc"))
+    md = solve_modes(s, 30)
+    d = tmp_path_factory.mktemp("uff")
+    uff = write_uff_modes(md, d / "ioc.unv", precision="double", points_path=d / "ioc.toml")
+    ref = acceleration_map(s, md, "crew", "x", CrewPushoff(REPORT_F0_N))  # the CLI default
+    return uff, d / "ioc.toml", ref, len(s.samples.labels)
+
+
+def test_locate_cli_on_a_uff_modal_model(capsys, ioc_uff):
+    uff, pts, ref, p = ioc_uff
+    rc, out, err = _run(
+        capsys,
+        "locate",
+        str(uff),
+        "--points",
+        str(pts),
+        "--crew",
+        "crew",
+        "--direction",
+        "x",
+        "--json",
+    )
+    assert rc == 0, err
+    data = json.loads(out)
+    assert data["method"] == "modal" and data["crew_point"] == "crew"
+    total = np.array([x["total_peak_g"] for x in data["samples"][:p]])
+    # reference: the FE model's own map at the exported nodes (lossless file: rounding)
+    np.testing.assert_allclose(total, ref.total_peak[:p] / G0, rtol=1e-9)
+    labels = [x["label"] for x in data["samples"]]
+    assert labels[:2] == ["grid:1", "grid:2"] and labels[-5:][1] == "crew"
+    assert any("no beam line" in w for w in data["warnings"])
+    rc, out, err = _run(
+        capsys, "locate", str(uff), "--points", str(pts), "--crew", "crew", "--on", "points"
+    )
+    assert rc == 0, err
+    assert "best location (total) on points" in out and "grids: total peak" in out
+
+
+def test_locate_cli_on_a_deck(capsys, tmp_path):
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "validation"))
+    from test_frame_closed_loop import write_deck
+
+    deck = write_deck(tmp_path / "truss.bdf")
+    rc, out, err = _run(
+        capsys, "locate", str(deck), "--units", "mm, N, s", "--crew", "grid:1", "--json"
+    )
+    assert rc == 0, err
+    data = json.loads(out)
+    assert data["method"] == "fem" and data["nodes"]
+    assert {n["component"] for n in data["nodes"]} <= {
+        f"grid:{a}..grid:{b}" for a in range(1, 10) for b in range(1, 10)
+    }
+    # bad input: one line naming the option, exit 2, nothing on stdout
+    for args, where in (
+        (["--crew", "grid:1"], "truss.bdf"),  # NASTRAN deck without units
+        (["--units", "mm, N, s", "--crew", "grid:77"], "--crew"),
+        (["--units", "N, N, s", "--crew", "grid:1"], "--units"),
+    ):
+        rc, out, err = _run(capsys, "locate", str(deck), *args)
+        assert rc == 2 and out == "" and len(err.strip().splitlines()) == 1, (args, err)
+        assert where in err, (args, err)

@@ -13,6 +13,7 @@ from microg.dynamics.modes import solve_modes
 from microg.location.amap import acceleration_map
 from microg.location.sampling import (
     BODY_LINE_SAMPLES,
+    element_lines,
     find_nodes,
     sample_lines,
     sample_shapes,
@@ -88,3 +89,32 @@ def test_find_nodes_on_a_straight_line():
     assert node.distance == pytest.approx(0.3, abs=1e-14)
     assert node.to_dict()["position_m"][2] == pytest.approx(0.3, abs=1e-14)
     assert find_nodes([line], positions, t + 1.0) == ()
+
+
+def test_element_lines_are_the_straight_chains_of_elements():
+    # a chain 0-1-2-3 along x (element 1-2 given twice, once reversed, and a zero-length
+    # element 3-4), a branch 1-5 perpendicular at node 1, and a bent pair 5-6 / 6-7
+    pos = np.array(
+        [[0, 0, 0], [1, 0, 0], [2, 0, 0], [4, 0, 0], [4, 0, 0], [1, 1, 0], [1, 2, 0], [2, 3, 0]],
+        float,
+    )
+    seg = np.array([[0, 1], [1, 2], [2, 1], [2, 3], [3, 4], [1, 5], [5, 6], [6, 7]])
+    labels = [f"g{i}" for i in range(8)]
+    lines = {ln.component: ln for ln in element_lines(pos, seg, labels=labels)}
+    # reference: the chains by hand (a T joint keeps the straight chain; a bend ends a line)
+    assert set(lines) == {"g0..g3", "g1..g6", "g6..g7"}
+    chain = lines["g0..g3"]
+    assert chain.index.tolist() == [0, 1, 2, 3] and not chain.rigid
+    np.testing.assert_array_equal(chain.axis, [1.0, 0.0, 0.0])
+    np.testing.assert_array_equal(chain.origin, pos[0])
+    assert lines["g1..g6"].index.tolist() == [1, 5, 6]
+    # three collinear elements at one node (0-1, 1-2 and an overlapping 1-3): no line
+    # continues through node 1, each element is its own line
+    three = element_lines(pos, np.array([[0, 1], [1, 2], [1, 3]]))
+    assert sorted(ln.index.tolist() for ln in three) == [[0, 1], [1, 2], [1, 3]]
+    # elements whose both ends are already on a line are left out
+    covered = np.zeros(8, bool)
+    covered[[0, 1, 2, 3]] = True
+    rest = element_lines(pos, seg, labels=labels, covered=covered)
+    assert {ln.component for ln in rest} == {"g1..g6", "g6..g7"}
+    assert element_lines(pos, np.zeros((0, 2), int)) == []

@@ -120,3 +120,86 @@ def test_maps_only_for_points_used_and_unknown_grid(fe):
     assert st.point("grid:5").translation.shape == (3, 30)  # on demand
     with pytest.raises(InputError, match="nearest grids"):
         st.point("grid:100000")
+
+
+def test_samples_are_views_and_products_equal_the_dense_ones(fe):
+    _, _, model = fe
+    st = modal_structure(model)
+    smp = st.samples
+    assert np.shares_memory(smp.phi_t, model.phi) and smp.position is model.xyz_m
+    assert smp.labels[:2] == ("grid:1", "grid:2") and len(smp) == model.n_grids
+    assert set(smp.component) == {"grids"}
+    m2 = solve_modes(st)
+    dense = np.einsum("gam,mk->gak", model.phi[:, :3, :], m2.phi)  # reference: dense product
+    got = smp.displacement(m2.phi)
+    single = np.count_nonzero(m2.phi, axis=0) == 1
+    assert single.sum() == 30 - 6  # elastic modes: one entry each; the rigid block mixes
+    # single-entry columns: the same one product per value (bit for bit); the rest: the
+    # same sums over the nonzero rows, in another order (rounding)
+    np.testing.assert_array_equal(got[:, :, single], dense[:, :, single])
+    np.testing.assert_allclose(got, dense, rtol=0, atol=1e-13 * np.abs(dense).max())
+    # a general (dense) coordinate matrix and a vector take the general path
+    rng = np.random.default_rng(1)
+    q = rng.standard_normal((30, 4))
+    np.testing.assert_allclose(
+        smp.displacement(q), np.einsum("gam,mk->gak", model.phi[:, :3, :], q), rtol=1e-12
+    )
+    np.testing.assert_allclose(smp.displacement(q[:, 0]), model.phi[:, :3, :] @ q[:, 0])
+    # the peak per mode without forming the displacements: exactly the dense maximum
+    np.testing.assert_array_equal(
+        smp.peak_translation(m2.phi)[single], np.max(np.abs(dense), axis=(0, 1))[single]
+    )
+    np.testing.assert_allclose(
+        smp.peak_translation(m2.phi), np.max(np.abs(dense), axis=(0, 1)), rtol=1e-13
+    )
+
+
+def _random_model(g: int, m: int, seed: int = 0):
+    """Identity-mass stand-in: exact rigid modes (QR of the rigid motions) + random others."""
+    from microg.models.modal import rigid_basis_at
+
+    rng = np.random.default_rng(seed)
+    xyz = rng.uniform(-20, 20, (g, 3))
+    q, _ = np.linalg.qr(rigid_basis_at(xyz).reshape(-1, 6))
+    el = rng.standard_normal((6 * g, m - 6))
+    el -= q @ (q.T @ el)
+    phi = np.concatenate([q, el / np.linalg.norm(el, axis=0)], axis=1).reshape(g, 6, m)
+    f = np.r_[np.zeros(6), np.sort(rng.uniform(0.1, 10.0, m - 6))]
+    return build_modal_model(
+        name="random",
+        grid_ids=np.arange(1, g + 1),
+        xyz_m=xyz,
+        freq_hz_signed=f,
+        phi=phi,
+        units=parse_units("m, N, s"),
+        source="random",
+        replace_rigid=False,
+    )
+
+
+def test_rigid_coefficients_from_a_few_grids_equal_the_full_fit():
+    from dataclasses import replace
+
+    from microg.errors import ModelError
+    from microg.models.modal import rigid_basis_at
+    from microg.structure.modal import RIGID_FIT_GRIDS, _fit_grids, rigid_coefficients
+
+    model = _random_model(2000, 12)
+    assert model.n_grids > RIGID_FIT_GRIDS and np.count_nonzero(model.rigid) == 6
+    a = rigid_coefficients(model)
+    # reference: least squares over every grid
+    r0 = rigid_basis_at(model.xyz_m).reshape(-1, 6)
+    ref, *_ = np.linalg.lstsq(r0, model.phi[:, :, :6].reshape(-1, 6), rcond=None)
+    # the rigid shapes are exact rigid motions to rounding: both fits give A to rounding
+    np.testing.assert_allclose(a, ref, rtol=0, atol=1e-12 * np.abs(ref).max())
+    # the fit grids are a few; the check is at every grid: spoil one grid outside them
+    used = set(_fit_grids(model.xyz_m).tolist())
+    k = next(i for i in range(model.n_grids) if i not in used)
+    phi = model.phi.copy()
+    phi[k, 0, 2] += 1e-3 * np.abs(phi[:, :, 2]).max()  # residual ~1e-5 > 1e-8
+    with pytest.raises(ModelError, match="not rigid-body motions"):
+        rigid_coefficients(replace(model, phi=phi))
+    # mass properties from A: identity mass per DOF, 2000 grids -> 2000 kg
+    st = modal_structure(model, ["grid:1"], samples=False)
+    assert st.total_mass == pytest.approx(2000.0, rel=1e-12)
+    assert np.allclose(st.center_of_mass, model.xyz_m.mean(axis=0), atol=1e-9 * 20)

@@ -50,6 +50,9 @@ FLAGS: dict[str, str] = {
     "t1": "--t1",
     "t13": "--t13",
     "t14": "--t14",
+    "units": "--units",
+    "wtmass": "--wtmass",
+    "points": "--points",
 }
 
 
@@ -264,6 +267,17 @@ def _unit_system(station: Any, model: str) -> str | None:
     show_default=True,
     help="Peak minimised for the best location.",
 )
+@click.option(
+    "--units", default=None, help="Units of a NASTRAN/UFF model file: 'LENGTH,FORCE,TIME'."
+)
+@click.option("--wtmass", type=float, default=None, help="NASTRAN PARAM WTMASS of the run.")
+@click.option(
+    "--points",
+    "points_file",
+    type=click.Path(dir_okay=False, path_type=Path),
+    default=None,
+    help='TOML file naming grids of an imported model (crew = "grid:55").',
+)
 @click.option("--json", "as_json", is_flag=True, help="Print the map as JSON.")
 @click.option(
     "--out",
@@ -289,6 +303,9 @@ def locate(
     no_rigid: bool,
     component: str | None,
     measure: str,
+    units: str | None,
+    wtmass: float | None,
+    points_file: Path | None,
     as_json: bool,
     out_dir: Path | None,
 ) -> None:
@@ -297,6 +314,13 @@ def locate(
     Per mode, Eq. 3.1 (|phi_j(s)| |phi_j(crew)| f0 [A_j]max / (M_jj omega_j t1)); the total
     is the peak over time of the modal sum.  Also the nodes of the fundamental elastic
     mode (report conclusion 7, Figure 9) and the quietest sample.
+
+    MODEL is a station (TOML or a shipped name) or an imported model: a NASTRAN .op2/.op4,
+    a UFF .unv/.uff, microg's own .npz modal-model file (mapped over every grid, named
+    points added as 'points': --on points picks the quietest of them), or a .bdf/.dat deck
+    (solved by microg's frame FE, nodes of the fundamental along its straight chains of
+    beams and rods).  --crew accepts grid:N for imported models; --method, --functions and
+    --elements apply to stations only.
     """
     from microg.location.amap import locate as run_locate
 
@@ -321,6 +345,9 @@ def locate(
             include_rigid=not no_rigid,
             on=component,
             measure=measure,
+            units=units,
+            wtmass=wtmass,
+            points=points_file,
         )
     text = dumps(result.to_dict())
     if out_dir is not None:
@@ -363,9 +390,10 @@ def _summary(result: Any) -> None:
             f"elastic {el.min():.3g} .. {el.max():.3g} g"
         )
     p = loc.position
+    name = f" {loc.label}" if loc.label else ""
     click.echo(
-        f"best location ({loc.measure}) on {loc.component}: ({p[0]:.4g}, {p[1]:.4g}, {p[2]:.4g}) m"
-        f" = z {p[2] / FT:.4g} ft, {loc.peak_g:.3g} g"
+        f"best location ({loc.measure}) on {loc.component}{name}: "
+        f"({p[0]:.4g}, {p[1]:.4g}, {p[2]:.4g}) m = z {p[2] / FT:.4g} ft, {loc.peak_g:.3g} g"
     )
     for w in result.warnings:
         click.echo(f"warning: {w}")

@@ -32,6 +32,7 @@ mode (period about an hour) is then the rigid rotation, which it equals over a p
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -56,6 +57,7 @@ from microg.location.peaks import (
 from microg.location.sampling import (
     Node,
     SampleLine,
+    element_lines,
     find_nodes,
     sample_lines,
     sample_shapes,
@@ -69,6 +71,7 @@ __all__ = [
     "FUNDAMENTAL_MIN_PARTICIPATION",
     "LATERAL",
     "MEASURES",
+    "POINTS_COMPONENT",
     "AccelerationMap",
     "Location",
     "LocateResult",
@@ -79,6 +82,7 @@ __all__ = [
     "default_direction",
     "default_point",
     "force_to_dict",
+    "is_imported",
     "locate",
     "location_structure",
     "point_peak",
@@ -92,6 +96,8 @@ __all__ = [
 FUNDAMENTAL_MIN_PARTICIPATION = 1e-6
 #: the force direction by default: the lateral axis of the report's plane
 LATERAL: dict[str, str] = {"xz": "x", "yz": "y", "3d": "x"}
+#: the carrier of the named points added to a map (imported models: ``on="points"``)
+POINTS_COMPONENT = "points"
 #: names of the map's measures (see :meth:`AccelerationMap.measure`)
 MEASURES = ("total", "elastic", "rigid", "bound", "long_time")
 #: defaults of :func:`locate` (and of ``microg locate``): the report's planar model
@@ -175,6 +181,9 @@ class AccelerationMap:
     include_rigid : bool
     method : str
     plane : str or None
+    labels : ndarray (p,) of str or None
+        Name of each sample (``"grid:7"``, a named point's name; ``""`` for the samples a
+        rigid line was densified with), when the structure's samples carry labels.
     """
 
     positions: np.ndarray
@@ -202,6 +211,7 @@ class AccelerationMap:
     include_rigid: bool
     method: str
     plane: str | None
+    labels: np.ndarray | None = None
 
     @property
     def n_samples(self) -> int:
@@ -263,6 +273,7 @@ class AccelerationMap:
             "samples": [
                 {
                     "component": str(self.component[i]),
+                    "label": None if self.labels is None else str(self.labels[i]),
                     "position_m": [float(v) for v in self.positions[i]],
                     "total_peak_g": float(self.total_peak[i] * g),
                     "elastic_peak_g": float(self.elastic_peak[i] * g),
@@ -344,6 +355,8 @@ class Location:
     peak : float
         Value of the chosen measure there, m/s^2.
     measure : str
+    label : str or None
+        The sample's name (``"grid:7"``, a named point), when the map has labels.
     """
 
     index: int
@@ -351,6 +364,7 @@ class Location:
     position: np.ndarray
     peak: float
     measure: str
+    label: str | None = None
 
     @property
     def peak_g(self) -> float:
@@ -358,9 +372,10 @@ class Location:
         return self.peak / G0
 
     def to_dict(self) -> dict:
-        """``{"component", "position_m", "measure", "peak_g"}``."""
+        """``{"component", "label", "position_m", "measure", "peak_g"}``."""
         return {
             "component": self.component,
+            "label": self.label,
             "position_m": [float(v) for v in self.position],
             "measure": self.measure,
             "peak_g": self.peak_g,
@@ -565,6 +580,8 @@ def acceleration_map(
     zeta: float | np.ndarray = 0.0,
     include_rigid: bool = True,
     duration: float | None = None,
+    points: Sequence[str] = (),
+    segments: np.ndarray | None = None,
 ) -> AccelerationMap:
     """Peak acceleration at every sample of the structure from a force at ``crew_point``.
 
@@ -598,14 +615,46 @@ def acceleration_map(
     duration : float, optional
         Length of the time window from the first breakpoint, s (default: to the last
         breakpoint plus three periods of the slowest elastic mode).
+    points : sequence of str
+        Named points (or ``grid:N``) added to the map after the samples, carrier
+        :data:`POINTS_COMPONENT`, each with its own translation map (rigid offsets
+        included): ``best_location(amap, component="points")`` is the quietest of them.
+    segments : ndarray (s, 2) of int, optional
+        Sample indices of two-node elements (a frame model's beams and rods): their
+        straight chains (:func:`microg.location.sampling.element_lines`) are lines of the
+        map besides the carriers' own lines, so the nodes of the fundamental are found on
+        a model whose nodes carry no beam names (a NASTRAN deck).  Elements with both ends
+        on a carrier's line are left out.
     """
     d = parse_direction(direction, "direction")
-    cp = structure.point(crew_point)
+    cp = _resolve(structure, crew_point, "crew_point")
     use, omega, rigid, elastic, zeta_arr = _modal_arrays(modes, zeta, include_rigid)
     phi = np.asarray(modes.phi, float)[:, use]
 
     positions, component, shapes = sample_shapes(structure, phi)
+    n0 = positions.shape[0]
+    own = getattr(structure.samples, "labels", None)
     positions, component, shapes, lines = sample_lines(positions, component, shapes)
+    labels = None
+    if own is not None and len(own) == n0:
+        labels = np.array(list(own) + [""] * (positions.shape[0] - n0), dtype=object)
+    if segments is not None:
+        covered = np.zeros(positions.shape[0], bool)
+        for line in lines:
+            covered[line.index] = True
+        seg = np.asarray(segments, dtype=np.int64).reshape(-1, 2)
+        if seg.size and (seg.min() < 0 or seg.max() >= n0):
+            raise InputError(f"segment sample indices must be in 0..{n0 - 1}", where="segments")
+        names = None if labels is None else [str(v) for v in labels]
+        lines = [*lines, *element_lines(positions, seg, labels=names, covered=covered)]
+    if points:
+        maps = [_resolve(structure, name, "points") for name in points]
+        base = labels if labels is not None else np.full(positions.shape[0], "", dtype=object)
+        labels = np.concatenate([base, np.array(list(points), dtype=object)])
+        positions = np.concatenate([positions, np.array([m.position for m in maps], float)])
+        component = np.concatenate([component, np.full(len(maps), POINTS_COMPONENT)])
+        extra = np.stack([np.asarray(m.translation, float) @ phi for m in maps])
+        shapes = np.concatenate([shapes, extra])
     resp = np.einsum("pam,a->pm", shapes, d)  # displacement along d per unit modal coordinate
     gamma = (np.asarray(cp.translation, float) @ phi).T @ d  # (m,)
     pk = _peaks(resp, gamma, omega, rigid, elastic, zeta_arr, crew, duration)
@@ -649,7 +698,21 @@ def acceleration_map(
         include_rigid=include_rigid,
         method=structure.method,
         plane=structure.plane,
+        labels=None if labels is None else labels.astype(str),
     )
+
+
+def _resolve(structure: Structure, name: str, where: str) -> Any:
+    """The point map of ``name``; an unknown name is an InputError naming ``where``."""
+    try:
+        return structure.point(name)
+    except InputError as exc:
+        raise InputError(exc.what, where=where, fix=exc.fix) from None
+    except KeyError:
+        known = ", ".join(sorted(structure.points)) or "(none)"
+        raise InputError(
+            f"unknown point {name!r}", where=where, fix=f"known points: {known}"
+        ) from None
 
 
 def point_peak(
@@ -734,7 +797,8 @@ def best_location(
             )
     idx = np.flatnonzero(mask)
     i = int(idx[np.argmin(values[idx])])
-    return Location(i, str(amap.component[i]), amap.positions[i], float(values[i]), measure)
+    label = None if amap.labels is None else str(amap.labels[i])
+    return Location(i, str(amap.component[i]), amap.positions[i], float(values[i]), measure, label)
 
 
 # --------------------------------------------------------------------------- the pipeline
@@ -815,16 +879,55 @@ def location_structure(
     return structure, d
 
 
-def _station(model: Station | str | Path) -> Station:
-    if isinstance(model, Station):
+def _load(model: Any, units: str | None, wtmass: float | None, points: str | Path | None) -> Any:
+    """A model object as it is, or a path / shipped name read by the one model loader."""
+    if not isinstance(model, str | Path):
+        if units is not None or wtmass is not None or points is not None:
+            raise InputError(
+                "units, wtmass and points apply when the model is read from a file",
+                where="units"
+                if units is not None
+                else ("wtmass" if wtmass is not None else "points"),
+                fix="pass the file's path, or give them to microg.load_model",
+            )
         return model
-    from microg.models.toml import load_station
+    from microg.models.load import load_model
 
-    return load_station(model)
+    return load_model(model, units=units, wtmass=wtmass, points=points)
+
+
+def is_imported(model: Any) -> bool:
+    """True for the models located over their own grids: modal models and frame graphs."""
+    return type(model).__name__ in ("ModalModel", "GraphModel")
+
+
+def _imported_structure(model: Any, crew: str) -> tuple[Structure, np.ndarray | None]:
+    """The structure of a modal model or frame graph, and its elements' sample segments.
+
+    A modal model becomes the modal-coordinate structure with its grids as samples
+    (:func:`microg.structure.modal.modal_structure`); it has no elements, hence no
+    segments.  A frame graph is assembled by the one discretisation entry; its beams and
+    rods between sampled nodes are the segments (the beam lines of the map).
+    """
+    from microg.structure.discretize import discretize
+
+    if type(model).__name__ == "ModalModel":
+        from microg.structure.modal import modal_structure
+
+        # the named points are listed; any grid:N (the crew point) resolves on access
+        return modal_structure(model, [p.name for p in model.points]), None
+    structure = discretize(model)
+    labels = getattr(structure.samples, "labels", None) or ()
+    index = {lab: i for i, lab in enumerate(labels)}
+    ends = [el.nodes for el in (*model.beams, *model.rods)]
+    seg = np.array(
+        [(index[a], index[b]) for a, b in ends if a in index and b in index], dtype=np.int64
+    ).reshape(-1, 2)
+    return structure, seg
 
 
 def locate(
-    model: Station | str | Path,
+    model: Station | Any | str | Path,
     crew: str | None = None,
     *,
     force: CrewPushoff | Any | None = None,
@@ -837,25 +940,40 @@ def locate(
     include_rigid: bool = DEFAULTS["include_rigid"],
     on: str | None = None,
     measure: str = DEFAULTS["measure"],
+    units: str | None = None,
+    wtmass: float | None = None,
+    points: str | Path | None = None,
 ) -> LocateResult:
     """Where to put the laboratory: the acceleration map of a crew force and its best point.
 
     ``discretize`` (free-free) -> ``solve_modes`` -> :func:`acceleration_map` ->
     :func:`best_location`.
 
+    A station (tree of beams) is discretised by ``method``.  An imported model is mapped
+    over its own grids: a modal model (:class:`~microg.models.modal.ModalModel`, read from
+    ``.op2``/``.op4``/``.unv``/``.npz``) over every grid, its named points added as
+    carrier ``"points"``; it has no elements, so the nodes of the fundamental are located
+    only where its grids are collinear (a warning says so otherwise).  A frame graph
+    (:class:`~microg.models.graph.GraphModel`, a ``.bdf`` deck) over its nodes and
+    concentrated masses, its named points added likewise, the nodes of the fundamental
+    along the straight chains of its beams and rods.  ``method``, ``plane`` (but for the
+    default direction) and ``n`` do not apply to imported models.
+
     Parameters
     ----------
-    model : Station, or a model file path or shipped name
+    model : Station, ModalModel, GraphModel, or a model file path or shipped name
     crew : str, optional
-        Named point where the force acts (default: the model's first point of kind crew).
+        Named point (or ``grid:N`` of an imported model) where the force acts (default: the
+        model's first point of kind crew).
     force : CrewPushoff or ForceHistory, optional
         N (default: the report's push-off, 25 lbf, 1 s, 13 s, 14 s).
     direction : str or ndarray (3,), optional
         Force direction (default: the plane's lateral axis, x for xz, y for yz).
     method : {"ritz", "fem"}
-        Assumed modes (the report's method) or 3-D frame elements.
+        Assumed modes (the report's method) or 3-D frame elements (stations only).
     plane : {"xz", "yz", "3d"}
-        Ritz: the planar model or the 3-D one; fem: sets the default direction only.
+        Ritz: the planar model or the 3-D one; fem and imported models: sets the default
+        direction only.
     n : int, optional
         Functions (ritz) or elements (fem) per beam (default: the discretisation's).
     n_modes : int, optional
@@ -865,23 +983,36 @@ def locate(
     include_rigid : bool
         Include the rigid-body modes.
     on : str, optional
-        Restrict the best location to this body or beam.
+        Restrict the best location to this body or beam; for imported models ``"points"``
+        (the named points), ``"grids"`` (a modal model's grids) or ``"grid"`` (a deck's
+        nodes).
     measure : {"total", "elastic", "rigid", "bound", "long_time"}
         Peak minimised for the best location.
+    units : str, optional
+        ``"LENGTH, FORCE, TIME"`` of a NASTRAN (or UFF without dataset 164) model file.
+    wtmass : float, optional
+        NASTRAN PARAM,WTMASS of the run.
+    points : str or Path, optional
+        Points/options TOML file naming grids of an imported model.
     """
     from microg.dynamics.forces import REPORT_F0_N
     from microg.dynamics.modes import solve_modes
 
-    station = _station(model)
+    mdl = _load(model, units, wtmass, points)
     if method not in ("ritz", "fem"):
         raise InputError(f"unknown method {method!r}", where="method", fix="use ritz or fem")
     if measure not in MEASURES:
         raise InputError(
             f"unknown measure {measure!r}", where="measure", fix=f"use {', '.join(MEASURES)}"
         )
+    force = force if force is not None else CrewPushoff(REPORT_F0_N)
+    if is_imported(mdl):
+        return _locate_imported(
+            mdl, crew, force, direction, plane, n_modes, zeta, include_rigid, on, measure
+        )
+    station = mdl
     crew = crew or default_point(station, "crew", "crew")
     check_point(station, crew, "crew")
-    force = force if force is not None else CrewPushoff(REPORT_F0_N)
     structure, d = location_structure(station, method, plane, n, direction)
     modes = solve_modes(structure, n_modes)
     amap = acceleration_map(
@@ -893,4 +1024,59 @@ def locate(
         warnings.append("the force excites no elastic mode: no nodes of a fundamental")
     return LocateResult(
         model=station.name, force=force, amap=amap, best=best, n=n, warnings=tuple(warnings)
+    )
+
+
+def _locate_imported(
+    model: Any,
+    crew: str | None,
+    force: Any,
+    direction: Any,
+    plane: str,
+    n_modes: int | None,
+    zeta: float,
+    include_rigid: bool,
+    on: str | None,
+    measure: str,
+) -> LocateResult:
+    """:func:`locate` on a modal model or a frame graph (see its docstring)."""
+    from microg.dynamics.modes import solve_modes
+
+    if plane not in LATERAL:
+        raise InputError(f"unknown plane {plane!r}", where="plane", fix="use xz, yz or 3d")
+    crew = crew or default_point(model, "crew", "crew")
+    d = parse_direction(
+        direction if direction is not None else default_direction(plane), "direction"
+    )
+    structure, segments = _imported_structure(model, crew)
+    _resolve(structure, crew, "crew")
+    modes = solve_modes(structure, n_modes)
+    names = [p.name for p in model.points]
+    amap = acceleration_map(
+        structure,
+        modes,
+        crew,
+        d,
+        force,
+        zeta=zeta,
+        include_rigid=include_rigid,
+        points=names,
+        segments=segments,
+    )
+    best = best_location(amap, component=on, measure=measure)
+    warnings = [f"model: {w}" for w in structure.meta.get("warnings", ())]
+    if amap.fundamental is None:
+        warnings.append("the force excites no elastic mode: no nodes of a fundamental")
+    elif not amap.lines:
+        what = (
+            "a modal model has no elements and its grids do not lie on one straight line"
+            if segments is None
+            else "the model has no straight chain of beams or rods between its nodes"
+        )
+        warnings.append(
+            f"{what}: there is no beam line to locate the nodes of the fundamental on "
+            "(the map over every sample and the quietest one are given)"
+        )
+    return LocateResult(
+        model=str(model.name), force=force, amap=amap, best=best, n=None, warnings=tuple(warnings)
     )

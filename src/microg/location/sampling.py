@@ -8,6 +8,8 @@ This module turns them into what the location stage needs:
 * :func:`sample_shapes`: positions, carriers and modal translations of the samples;
 * :func:`sample_lines`: the samples grouped into straight lines (a beam; a rigid body whose
   samples are collinear), rigid lines filled densely by their exact affine law;
+* :func:`element_lines`: straight chains of two-node elements between samples (the beams
+  and rods of a general frame model, whose nodes carry no beam names);
 * :func:`find_nodes`: the sign changes of a displacement along each line (the nodes of the
   fundamental mode, report conclusion 7), located by linear interpolation.
 
@@ -26,8 +28,10 @@ from microg.structure.structure import Structure
 
 __all__ = [
     "BODY_LINE_SAMPLES",
+    "STRAIGHT_TOL",
     "Node",
     "SampleLine",
+    "element_lines",
     "find_nodes",
     "sample_lines",
     "sample_shapes",
@@ -35,6 +39,9 @@ __all__ = [
 
 #: rigid-body lines are densified to at least this many samples
 BODY_LINE_SAMPLES = 121
+#: two elements meeting at a node continue one straight line when the cosine of the angle
+#: between them is below ``-(1 - STRAIGHT_TOL)`` (about 4e-5 rad)
+STRAIGHT_TOL = 1e-9
 
 
 @dataclass(frozen=True)
@@ -292,3 +299,100 @@ def find_nodes(
             seen.append(p[-1])
             out.append(Node(line.component, p[-1], float((p[-1] - line.origin) @ line.axis)))
     return tuple(out)
+
+
+def element_lines(
+    positions: np.ndarray,
+    segments: np.ndarray,
+    *,
+    labels: Sequence[str] | None = None,
+    covered: np.ndarray | None = None,
+) -> list[SampleLine]:
+    """Straight chains of two-node elements between samples (a frame model's beam lines).
+
+    Two elements meeting at a node belong to one line when they continue each other
+    straight through it (anti-parallel within :data:`STRAIGHT_TOL` in cosine) and neither
+    has another straight continuation there (a node where three collinear elements meet
+    ends the lines).  A line is the chain's samples ordered along its axis; it is never
+    rigid (the displacement between samples is interpolated linearly, as along a meshed
+    beam).
+
+    Parameters
+    ----------
+    positions : ndarray (p, 3)
+        Sample positions, m.
+    segments : ndarray (s, 2) of int
+        Sample indices of each element's two nodes.
+    labels : sequence of str, optional
+        Sample labels; a line is named ``"<first>..<last>"`` by its end samples (default
+        ``"line:K"``).
+    covered : ndarray (p,) of bool, optional
+        Samples already on a line: elements with both ends covered are left out.
+
+    Returns
+    -------
+    list of SampleLine
+    """
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    seg = np.asarray(segments, dtype=np.int64).reshape(-1, 2)
+    if covered is not None:
+        seg = seg[~(covered[seg[:, 0]] & covered[seg[:, 1]])]
+    seg = np.sort(seg, axis=1)
+    seg = seg[seg[:, 0] != seg[:, 1]]
+    scale = float(np.ptp(positions, axis=0).max()) if positions.size else 1.0
+    vec = positions[seg[:, 1]] - positions[seg[:, 0]]
+    length = np.linalg.norm(vec, axis=1)
+    keep = length > 1e-9 * (scale or 1.0)
+    seg, vec, length = seg[keep], vec[keep], length[keep]
+    if seg.size == 0:
+        return []
+    seg, first = np.unique(seg, axis=0, return_index=True)
+    u = vec[first] / length[first, None]
+    ns = seg.shape[0]
+    # incidences: (node, element, unit vector from the node along the element)
+    inc_node = np.r_[seg[:, 0], seg[:, 1]]
+    inc_seg = np.r_[np.arange(ns), np.arange(ns)]
+    inc_u = np.r_[u, -u]
+    order = np.argsort(inc_node, kind="stable")
+    inc_node, inc_seg, inc_u = inc_node[order], inc_seg[order], inc_u[order]
+    _, start, count = np.unique(inc_node, return_index=True, return_counts=True)
+    deg = np.repeat(count, count)
+    rank = np.arange(inc_node.size) - np.repeat(start, count)
+    pa_l, pb_l = [], []
+    for off in range(1, int(count.max())):  # pairs at each node, by offset (<= degree)
+        a = np.flatnonzero(rank + off < deg)
+        b = a + off
+        straight = np.einsum("ij,ij->i", inc_u[a], inc_u[b]) < -(1.0 - STRAIGHT_TOL)
+        pa_l.append(a[straight])
+        pb_l.append(b[straight])
+    pa = np.concatenate(pa_l) if pa_l else np.zeros(0, np.int64)
+    pb = np.concatenate(pb_l) if pb_l else np.zeros(0, np.int64)
+    partners = np.bincount(np.r_[pa, pb], minlength=inc_node.size)
+    join = (partners[pa] == 1) & (partners[pb] == 1)
+    ea, eb = inc_seg[pa[join]], inc_seg[pb[join]]
+    graph = coo_matrix((np.ones(ea.size), (ea, eb)), shape=(ns, ns))
+    n_lines, which = connected_components(graph, directed=False)
+    # order each line's samples along the axis of its first element
+    lead = np.full(n_lines, -1)
+    lead[which[::-1]] = np.arange(ns)[::-1]  # first element of each line
+    axis = u[lead]
+    axis = (
+        axis
+        * np.where(axis[np.arange(n_lines), np.argmax(np.abs(axis), axis=1)] > 0, 1, -1)[:, None]
+    )
+    ends = np.r_[seg[:, 0], seg[:, 1]]
+    line_of = np.r_[which, which]
+    pairs = np.unique(np.column_stack([line_of, ends]), axis=0)
+    origin_ref = positions[seg[lead, 0]]
+    t = np.einsum("ij,ij->i", positions[pairs[:, 1]] - origin_ref[pairs[:, 0]], axis[pairs[:, 0]])
+    order = np.lexsort((t, pairs[:, 0]))
+    pairs, t = pairs[order], t[order]
+    cuts = np.flatnonzero(np.diff(pairs[:, 0])) + 1
+    out = []
+    line_ids = pairs[np.r_[0, cuts], 0]
+    for k, (lid, idx) in enumerate(zip(line_ids, np.split(pairs[:, 1], cuts), strict=True)):
+        name = f"{labels[idx[0]]}..{labels[idx[-1]]}" if labels is not None else f"line:{k + 1}"
+        out.append(SampleLine(name, idx, positions[idx[0]], axis[lid], False))
+    return out

@@ -290,6 +290,8 @@ def read_options(path: str | Path) -> ModelOptions:
     label = str(path)
     try:
         text = Path(path).read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise ModelError("no such file", where=label, fix="give the points file's path") from None
     except (OSError, UnicodeDecodeError) as exc:
         raise ModelError(f"cannot read: {exc}", where=label) from None
     try:
@@ -866,7 +868,7 @@ def save_modal_model(model: ModalModel, path: str | Path) -> Path:
         "warnings": list(model.warnings),
         "meta": {k: v for k, v in model.meta.items() if _jsonable(v)},
     }
-    arrays = {
+    arrays: dict[str, Any] = {
         "format": np.array(FORMAT),
         "version": np.array(FORMAT_VERSION),
         "name": np.array(model.name),

@@ -15,12 +15,13 @@ The rigid-body mass is ``(A A^T)^-1`` (from ``A^T M_rr A = I``).
 Point maps are built only for the points asked for: :class:`GridPointMaps` lists the
 named points and the requested grids, and builds the map of any other ``grid:N`` on first
 access, so a 20,000-grid model observed at 10 grids never forms maps for all grids.
+The samples (:class:`ModalSamples`, the grids) are views of the model; the rigid-body
+coefficients are fitted at a few grids and verified at all of them (``O(grids)``).
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterator, Mapping, Sequence
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -28,7 +29,14 @@ from microg.errors import InputError, ModelError
 from microg.models.modal import ModalModel, rigid_basis_at
 from microg.structure.structure import PointMap, Structure
 
-__all__ = ["GridPointMaps", "ModalSamples", "modal_structure", "rigid_coefficients"]
+__all__ = [
+    "GRID_COMPONENT",
+    "RIGID_FIT_GRIDS",
+    "GridPointMaps",
+    "ModalSamples",
+    "modal_structure",
+    "rigid_coefficients",
+]
 
 _DIRECTIONS = ("x", "y", "z", "rx", "ry", "rz")
 
@@ -86,9 +94,21 @@ class GridPointMaps(Mapping[str, PointMap]):
         return len(self._names)
 
 
-@dataclass(frozen=True)
+#: the carrier of a modal model's grids in acceleration maps (no element connectivity)
+GRID_COMPONENT = "grids"
+#: at most this many grids determine the rigid-body coefficients (all grids verify them)
+RIGID_FIT_GRIDS = 64
+
+
 class ModalSamples:
-    """Translations of every grid from modal coordinates (maps and plots).
+    """The grids of a modal model as samples (maps, plots, modal-mass peaks), built lazily.
+
+    Nothing is copied: positions and translations are views of the model's arrays, and
+    labels are formed on first use.  :meth:`displacement` multiplies by the coordinates'
+    nonzero entries only, so the modes of the diagonal modal structure (a signed
+    permutation, mixed only within the rigid block) cost ``O(grids x modes)``, not
+    ``O(grids x modes^2)``; :meth:`peak_translation` gives the largest translation of each
+    mode without forming the displacements at all.
 
     Attributes
     ----------
@@ -96,41 +116,136 @@ class ModalSamples:
         Grid positions, m.
     labels : tuple of str
         ``"grid:N"``.
+    component : ndarray (g,) of str
+        :data:`GRID_COMPONENT` for every grid (a modal model has no element connectivity).
     phi_t : ndarray (g, 3, m)
-        Translational rows of the mode shapes.
+        Translational rows of the mode shapes (a view of ``model.phi``).
     """
 
-    position: np.ndarray
-    labels: tuple[str, ...]
-    phi_t: np.ndarray
+    def __init__(self, model: ModalModel):
+        self._model = model
+        self._labels: tuple[str, ...] | None = None
+        self._peak: np.ndarray | None = None
+
+    @property
+    def position(self) -> np.ndarray:
+        """Grid positions, m (g, 3)."""
+        return self._model.xyz_m
+
+    @property
+    def phi_t(self) -> np.ndarray:
+        """Translational rows of the shapes (g, 3, m), a view."""
+        return self._model.phi[:, :3, :]
+
+    @property
+    def labels(self) -> tuple[str, ...]:
+        """``"grid:N"`` of every grid."""
+        if self._labels is None:
+            self._labels = tuple(f"grid:{g}" for g in self._model.grid_ids.tolist())
+        return self._labels
+
+    @property
+    def component(self) -> np.ndarray:
+        """The carrier of every grid, :data:`GRID_COMPONENT`."""
+        return np.full(self._model.n_grids, GRID_COMPONENT)
 
     def __len__(self) -> int:
-        return int(self.position.shape[0])
+        return self._model.n_grids
 
     def displacement(self, q: np.ndarray) -> np.ndarray:
-        """Grid translations, m: (g, 3) for q (m,), (g, 3, k) for q (m, k)."""
-        return np.asarray(self.phi_t @ np.asarray(q, float))
+        """Grid translations, m: (g, 3) for q (m,), (g, 3, k) for q (m, k).
+
+        Columns of ``q`` with one nonzero entry are a scaled shape (bit for bit the dense
+        product); the others are multiplied over their nonzero rows only.
+        """
+        q = np.asarray(q, float)
+        pt = self.phi_t
+        if q.ndim == 1:
+            return np.asarray(pt @ q)
+        nz = q != 0
+        count = nz.sum(axis=0)
+        single = np.flatnonzero(count == 1)
+        r = np.argmax(nz[:, single], axis=0)
+        if q.shape[0] == q.shape[1] and np.array_equal(r, single):
+            # the single entries are on the diagonal (the modal structure's own modes): one
+            # streaming product, the other columns zero until set below
+            scale = np.zeros(q.shape[1])
+            scale[single] = q[single, single]
+            out = pt * scale
+        else:
+            out = np.zeros((pt.shape[0], 3, q.shape[1]))
+            if single.size:
+                out[:, :, single] = pt[:, :, r] * q[r, single]
+        multi = np.flatnonzero(count > 1)
+        if multi.size:
+            rows = np.flatnonzero(nz[:, multi].any(axis=1))
+            out[:, :, multi] = pt[:, :, rows] @ q[np.ix_(rows, multi)]
+        return out
+
+    def shape_peaks(self) -> np.ndarray:
+        """Largest |translation| of each of the model's shapes over grids and axes (m,)."""
+        if self._peak is None:
+            self._peak = np.max(np.abs(self.phi_t), axis=(0, 1))
+        return self._peak
+
+    def peak_translation(self, q: np.ndarray) -> np.ndarray:
+        """``max over grids and axes of |displacement(q)|`` per column of q (k,).
+
+        Exact: for a column with one nonzero entry ``q_rj`` it is ``|q_rj|`` times the
+        shape's own peak (rounding is monotone, so the maximum commutes with the scaling);
+        other columns are formed over their nonzero rows.
+        """
+        q = np.asarray(q, float).reshape(self._model.n_modes, -1)
+        nz = q != 0
+        count = nz.sum(axis=0)
+        out = np.zeros(q.shape[1])
+        single = np.flatnonzero(count == 1)
+        if single.size:
+            r = np.argmax(nz[:, single], axis=0)
+            out[single] = np.abs(q[r, single]) * self.shape_peaks()[r]
+        multi = np.flatnonzero(count > 1)
+        if multi.size:
+            out[multi] = np.max(np.abs(self.displacement(q[:, multi])), axis=(0, 1))
+        return out
+
+
+def _fit_grids(xyz: np.ndarray) -> np.ndarray:
+    """Up to RIGID_FIT_GRIDS grid rows spread over the model (its extremes included)."""
+    g = xyz.shape[0]
+    if g <= RIGID_FIT_GRIDS:
+        return np.arange(g)
+    ext = np.r_[np.argmin(xyz, axis=0), np.argmax(xyz, axis=0)]
+    spread = np.linspace(0, g - 1, RIGID_FIT_GRIDS - ext.size).astype(int)
+    return np.unique(np.r_[ext, spread])
 
 
 def rigid_coefficients(model: ModalModel) -> np.ndarray:
     """``A`` (6, k) with ``phi_rigid = R0 A`` exactly (R0 about the basic origin).
 
-    Raises ModelError when the rigid modes are not rigid-body motions of the grids.
+    ``A`` is the least-squares fit at up to :data:`RIGID_FIT_GRIDS` grids (one grid
+    already determines it: ``R0`` of a grid is invertible); the fit is verified at every
+    grid.  Raises ModelError when the rigid modes are not rigid-body motions of the grids.
     """
     idx = np.flatnonzero(model.rigid)
     if idx.size == 0:
         return np.zeros((6, 0))
-    R0 = rigid_basis_at(model.xyz_m).reshape(-1, 6)
-    pr = model.phi[:, :, idx].reshape(-1, idx.size)
-    a, *_ = np.linalg.lstsq(R0, pr, rcond=None)
-    err = np.linalg.norm(pr - R0 @ a) / max(np.linalg.norm(pr), 1e-300)
+    sub = _fit_grids(model.xyz_m)
+    r_sub = rigid_basis_at(model.xyz_m[sub]).reshape(-1, 6)
+    a, *_ = np.linalg.lstsq(r_sub, model.phi[sub][:, :, idx].reshape(-1, idx.size), rcond=None)
+    pr = model.phi[:, :, idx]  # (g, 6, k)
+    # R0 a at every grid: translation a_t + a_r x x_g, rotation a_r
+    x = model.xyz_m[:, :, None]
+    ar = a[3:][None, :, :]
+    pred_t = a[:3][None] + np.cross(ar, x, axisa=1, axisb=1, axisc=1)
+    err2 = np.sum((pr[:, :3] - pred_t) ** 2) + np.sum((pr[:, 3:] - ar) ** 2)
+    err = np.sqrt(err2) / max(float(np.linalg.norm(pr)), 1e-300)
     if err > 1e-8:
         raise ModelError(
             f"the modes marked rigid are not rigid-body motions of the grids (residual {err:.2g})",
             where=model.source or "modal model",
             fix="read the model with rigid-mode replacement on",
         )
-    return a
+    return np.asarray(a)
 
 
 def modal_structure(
@@ -145,9 +260,10 @@ def modal_structure(
         Names (named points or ``grid:N``) to list in ``Structure.points``; default the
         model's named points.  Any other ``grid:N`` still resolves on access.
     samples : bool
-        Attach :class:`ModalSamples` of all grids (maps, plots, the modal-mass peak of
-        :func:`microg.dynamics.modes.solve_modes`, which then costs O(grids x modes^2));
-        False for an analysis at a few points of a large model.
+        Attach :class:`ModalSamples` of all grids (views of the model, nothing copied):
+        the acceleration maps, plots and the modal-mass peak of
+        :func:`microg.dynamics.modes.solve_modes` over every grid (one pass over the
+        shapes, ``O(grids x modes)``).  False: the named points and ``points`` only.
 
     Returns
     -------
@@ -186,13 +302,7 @@ def modal_structure(
         total_mass=total,
         center_of_mass=cm,
         inertia_cm=inertia,
-        samples=ModalSamples(
-            position=model.xyz_m,
-            labels=tuple(f"grid:{g}" for g in model.grid_ids),
-            phi_t=model.phi[:, :3, :],
-        )
-        if samples
-        else None,
+        samples=ModalSamples(model) if samples else None,
         meta={
             "model": model.name,
             "source": model.source,
