@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import pytest
@@ -19,11 +20,16 @@ def _run(capsys, args: list[str]) -> tuple[int, str, str]:
 
 
 @pytest.fixture(scope="module")
-def default_json(tmp_path_factory) -> dict:
+def default_out(tmp_path_factory) -> Path:
     out = tmp_path_factory.mktemp("rep") / "r"
     rc = main(["reproduce", "--out", str(out), "--json"])
     assert rc == 0
-    return json.loads((out / "results.json").read_text())
+    return out
+
+
+@pytest.fixture(scope="module")
+def default_json(default_out: Path) -> dict:
+    return json.loads((default_out / "results.json").read_text())
 
 
 def test_contract_keys(default_json: dict) -> None:
@@ -160,6 +166,10 @@ def test_a_directory_microg_did_not_write_is_refused(tmp_path: Path, capsys) -> 
         (["--f0", "-5"], "--f0"),
         (["--z-e", "nan ft"], "--z-e"),
         (["--z-e", "1e400 ft"], "--z-e"),
+        (["--z-e", "100 ft"], "--z-e"),  # on the keel: Eq. 3.1 does not hold there
+        (["--z-a", "-200 ft"], "--z-a"),  # below the main body
+        (["--z-a", "5000"], "--z-a"),  # bare number: ft
+        (["--z-e", "3 kg"], "--z-e"),
     ],
 )
 def test_more_bad_input(tmp_path: Path, capsys, args, needle) -> None:
@@ -167,3 +177,139 @@ def test_more_bad_input(tmp_path: Path, capsys, args, needle) -> None:
     rc, _, err = _run(capsys, ["reproduce", *out_args, *args])
     assert rc == 2 and needle in err and err.count("\n") == 1 and "Traceback" not in err
     assert not (tmp_path / "never").exists()
+
+
+TITLE = (
+    "Analytical determination of space station response to crew motion and design of "
+    "suspension system for microgravity experiments"
+)
+
+
+def test_json_names_the_seed_report(default_json: dict) -> None:
+    sr = default_json["seed_report"]
+    assert sr["title"] == TITLE
+    assert sr["program"] == "NASA/ASEE"
+    # not legible in the OCR'd copy: null, with the reason beside it
+    assert sr["authors"] is None and sr["authors_note"]
+    assert sr["year"] is None and "August 1984" in sr["year_note"]
+    assert sr["file_name"] == "000_21c0b08f89afe689.txt"
+
+
+def test_json_meta_is_the_provenance(tmp_path: Path, capsys) -> None:
+    import hashlib
+
+    import microg
+
+    out = tmp_path / "rep"
+    args = ["reproduce", "--out", str(out), "--json", "--f0", "25 lbf"]
+    rc, stdout, _ = _run(capsys, args)
+    assert rc == 0
+    meta = json.loads(stdout)["meta"]
+    assert meta["microg_version"] == microg.__version__
+    assert meta["command"] == "microg reproduce --out " + str(out) + " --json --f0 '25 lbf'"
+    assert re.fullmatch(r"\d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ", meta["created_utc"])
+    data = Path(microg.__file__).parent / "data"
+    sha = {p.name: hashlib.sha256(p.read_bytes()).hexdigest() for p in data.glob("*.toml")}
+    assert meta["printed_values_sha256"] == sha["_seed_printed.toml"]
+    assert {m["name"]: m["sha256"] for m in meta["models"]} == {
+        "ioc": sha["ioc.toml"],
+        "ioc-no-orbiter": sha["ioc-no-orbiter.toml"],
+    }
+    assert meta["seed_report_file"] == "000_21c0b08f89afe689.txt"
+    assert len(meta["seed_report_sha256"]) == 64
+    page = (out / "report.html").read_text()
+    text = _unescaped(page)
+    for value in (meta["command"], meta["printed_values_sha256"], meta["seed_report_sha256"]):
+        assert value in text
+    assert "<h2>Provenance</h2>" in page and meta["created_utc"] in page
+
+
+def _unescaped(page: str) -> str:
+    import html
+
+    return html.unescape(page)
+
+
+def test_report_states_the_agreement(default_out: Path, default_json: dict) -> None:
+    page = (default_out / "report.html").read_text()
+    text = _unescaped(page)
+    a = default_json["agreement"]
+    # the page's headline and counts are the JSON's, which are the comparisons'
+    assert a["headline"] in text
+    comps = default_json["comparisons"]
+    for g in a["groups"]:
+        mine = [c for c in comps if c["group"] == g["key"]]
+        assert g["compared"] == len(mine) and g["agree"] == sum(c["agrees"] for c in mine)
+        shade = "ok" if g["compared"] and not g["differ"] else ""
+        assert f'<td>{g["compared"]}</td><td class="{shade}">{g["agree"]}</td>' in page
+        assert g["tolerance"] in text and g["justification"] in text
+    assert a["reproduction"]["compared"] == sum(
+        g["compared"] for g in a["groups"] if g["kind"] == "reproduction"
+    )
+    # every difference links its erratum, which has an anchor on the page
+    for c in comps:
+        if not c["agrees"]:
+            assert f'href="#{c["erratum"]}"' in page and f'<tr id="{c["erratum"]}">' in page
+    assert TITLE in text and "<h2>Symbols and units</h2>" in page
+
+
+def test_console_summary_states_the_agreement(tmp_path: Path, capsys, default_json) -> None:
+    rc, stdout, _ = _run(capsys, ["reproduce", "--out", str(tmp_path / "o")])
+    assert rc == 0 and default_json["agreement"]["headline"] in stdout
+
+
+def test_other_inputs_are_not_compared_with_printed_accelerations(tmp_path, capsys) -> None:
+    rc, stdout, _ = _run(
+        capsys, ["reproduce", "--out", str(tmp_path / "o"), "--json", "--z-e", "-30 ft"]
+    )
+    d = json.loads(stdout)
+    assert rc == 0 and d["options"]["report_inputs"] is False
+    groups = {g["key"]: g for g in d["agreement"]["groups"]}
+    assert groups["table4_bending_accel"]["compared"] == 0
+    assert "not compared" in groups["table4_bending_accel"]["note"]
+    assert groups["appendix_c_omega2"]["compared"] == 8
+
+
+def test_case_filter_counts_only_that_case(tmp_path: Path, capsys) -> None:
+    rc, stdout, _ = _run(
+        capsys, ["reproduce", "--out", str(tmp_path / "o"), "--json", "--case", "yz_orbiter"]
+    )
+    d = json.loads(stdout)
+    wheres = {c["where"] for c in d["comparisons"]}
+    assert wheres == {
+        "Appendix C-3",
+        "Table 4 yz_orbiter",
+        "Appendix C-3 vs model",
+        "Section 3, centre-of-mass table",
+        "Table 2 vs model",
+    }
+    assert d["agreement"]["reproduction"]["compared"] == 2 + 8 + 2 + 2 + 2 + 1 + 1
+    assert [m["name"] for m in d["meta"]["models"]] == ["ioc"]
+
+
+def test_help_names_units_and_defaults(capsys) -> None:
+    rc, out, _ = _run(capsys, ["reproduce", "--help"])
+    assert rc == 0
+    text = " ".join(out.split())
+    for option, default, unit in [
+        ("--f0", "25 lbf", "bare number: lbf"),
+        ("--t1", "1 s", "bare number: s"),
+        ("--t13", "13 s", "bare number: s"),
+        ("--t14", "14 s", "bare number: s"),
+        ("--z-e", "-55 ft", "bare number: ft"),
+        ("--z-a", "-55 ft", "bare number: ft"),
+        ("--out", "microg-reproduce", "report.html"),
+    ]:
+        block = text[text.index(option + " ") :]
+        block = block[: block.index("[default:") + 60]
+        assert unit in block and f"[default: {default}]" in block, option
+    assert "-126.66 ft <= z <= 0" in text  # the range of --z-e and --z-a
+    assert "Default: all four" in text
+    assert TITLE.split(" and ")[0] in text  # the seed report, by its title
+
+
+def test_id_ranges() -> None:
+    from microg.report.html import id_ranges
+
+    assert id_ranges(["E9", "E10", "E11", "E14"]) == [("E9-E11", "E9"), ("E14", "E14")]
+    assert id_ranges([]) == []

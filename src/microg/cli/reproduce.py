@@ -2,53 +2,77 @@
 
 from __future__ import annotations
 
+import shlex
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import click
 
 from microg.cli.params import QuantityType
 from microg.seed.ioc import CASES
 
+if TYPE_CHECKING:
+    from microg.seed.reproduce import Reproduction
+
 __all__ = ["reproduce"]
 
+#: library parameter -> command-line option
+FLAGS = {"z_e": "--z-e", "z_a": "--z-a", "cases": "--case"}
 
-@click.command()
+_MAIN_BODY = "on the rigid main body, -126.66 ft <= z <= 0 (Eq. 3.1 holds there only)"
+
+
+class _RecordedCommand(click.Command):
+    """A command that keeps its own argument list, for the provenance's command line."""
+
+    def parse_args(self, ctx: click.Context, args: list[str]) -> list[str]:
+        ctx.meta["microg.reproduce.argv"] = list(args)
+        return super().parse_args(ctx, args)
+
+
+@click.command(cls=_RecordedCommand)
 @click.option(
     "--out",
     "out_dir",
     type=click.Path(file_okay=False, path_type=Path),
     default=Path("microg-reproduce"),
     show_default=True,
-    help="Directory for report.html, figure3.png, figure4.png and results.json.",
+    help="Directory written as a whole: report.html (self-contained), results.json, "
+    "figure3.png, figure4.png and lab-response.png.",
 )
-@click.option("--json", "as_json", is_flag=True, help="Also print results.json to stdout.")
+@click.option(
+    "--json",
+    "as_json",
+    is_flag=True,
+    help="Print results.json to stdout instead of the summary (the file is written too).",
+)
 @click.option(
     "--f0",
     type=QuantityType("force", "lbf"),
     default="25 lbf",
     show_default=True,
-    help="Crew force peak (bare number: lbf).",
+    help="Crew force peak f0 (Eq. 2.16), > 0, e.g. '111 N' (bare number: lbf).",
 )
 @click.option(
     "--t1",
     type=QuantityType("time", "s", minimum=0.0, strict=True),
     default="1 s",
     show_default=True,
-    help="Push-off ramp duration (bare number: s).",
+    help="End of the push-off ramp t1 (Eq. 2.16), > 0 (bare number: s).",
 )
 @click.option(
     "--t13",
     type=QuantityType("time", "s"),
     default="13 s",
     show_default=True,
-    help="Landing start, >= t1 (bare number: s).",
+    help="Start of the landing t13, >= t1 (bare number: s).",
 )
 @click.option(
     "--t14",
     type=QuantityType("time", "s"),
     default="14 s",
     show_default=True,
-    help="Landing end, > t13 (bare number: s).",
+    help="End of the landing t14, > t13 (bare number: s).",
 )
 @click.option(
     "--z-e",
@@ -56,7 +80,8 @@ __all__ = ["reproduce"]
     type=QuantityType("length", "ft"),
     default="-55 ft",
     show_default=True,
-    help="Observation point z from the keel joint (bare number: ft).",
+    help=f"Observation point z_e along the keel axis from the keel joint, {_MAIN_BODY} "
+    "(bare number: ft).",
 )
 @click.option(
     "--z-a",
@@ -64,14 +89,16 @@ __all__ = ["reproduce"]
     type=QuantityType("length", "ft"),
     default="-55 ft",
     show_default=True,
-    help="Crew force z from the keel joint (bare number: ft).",
+    help=f"Crew force point z_a along the keel axis from the keel joint, {_MAIN_BODY} "
+    "(bare number: ft).",
 )
 @click.option(
     "--case",
     "cases",
     type=click.Choice(list(CASES)),
     multiple=True,
-    help="Restrict to these cases (repeatable; default: all four).",
+    help="Restrict to a case of Appendix C (repeatable): X-Z or Y-Z plane, with or without "
+    "the orbiter (C-1..C-4). Default: all four.",
 )
 def reproduce(
     out_dir: Path,
@@ -86,11 +113,16 @@ def reproduce(
 ) -> None:
     """Recompute the seed report's Appendix C, Table 4 and Figures 3-4, with an errata.
 
-    Writes OUT/report.html (self-contained), OUT/figure3.png, OUT/figure4.png,
-    OUT/lab-response.png (Eq. 2.20b at z_e) and OUT/results.json; every computed value
-    follows the crew-force and point options.
+    The seed report: "Analytical determination of space station response to crew motion
+    and design of suspension system for microgravity experiments" (NASA/ASEE).  Every
+    printed value is compared with its recomputation within a stated tolerance, and every
+    difference is explained.  Writes OUT/report.html (self-contained), OUT/results.json,
+    OUT/figure3.png, OUT/figure4.png and OUT/lab-response.png (Eq. 2.20b at z_e).  Every
+    computed value follows the crew-force and point options; the printed accelerations are
+    compared only with the report's own inputs (the defaults).
     """
     from microg._io import check_writable, dumps, write_run_directory
+    from microg.cli._errors import flag_errors
     from microg.dynamics.crew import CrewPushoff
     from microg.plotting.common import png_bytes, png_data_uri
     from microg.plotting.seed import figure3, figure4, point_response_figure
@@ -99,19 +131,12 @@ def reproduce(
     from microg.seed.reproduce import ReproduceOptions
     from microg.seed.reproduce import reproduce as run
 
+    argv = click.get_current_context().meta.get("microg.reproduce.argv", [])
+    command = shlex.join(["microg", "reproduce", *argv])
     check_writable(out_dir, "--out")  # before computing: a bad --out fails at once
     crew = CrewPushoff.checked(f0, t1, t13, t14)
-    rep = run(ReproduceOptions(crew, z_e, z_a))
-    if cases:
-        rep = type(rep)(
-            rep.options,
-            {k: v for k, v in rep.appendix_c.items() if k in cases},
-            {k: v for k, v in rep.table4.items() if k in cases},
-            rep.curves,
-            rep.errata,
-            rep.model_mass,
-            {k: v for k, v in rep.point_response.items() if k in cases},
-        )
+    with flag_errors(FLAGS):
+        rep = run(ReproduceOptions(crew, z_e, z_a), cases=cases or None, command=command)
     fig3 = png_bytes(figure3(rep.curves))
     fig4 = png_bytes(figure4(rep.curves))
     fig_resp = png_bytes(point_response_figure(rep.point_response, z_e / FT, z_a / FT))
@@ -132,7 +157,8 @@ def reproduce(
         _summary(rep, path)
 
 
-def _summary(rep, path: Path) -> None:
+def _summary(rep: Reproduction, path: Path) -> None:
+    """The console summary: Table 4 printed and recomputed, the agreement, the errata."""
     click.echo("Table 4 (printed -> recomputed)")
     for case, t4 in rep.table4.items():
         for j, b in enumerate(t4.bending, 1):
@@ -145,4 +171,6 @@ def _summary(rep, path: Path) -> None:
             f"  {case:14s} libration: w {lib.printed_omega:.4g} -> {lib.omega:.4g} rad/s, "
             f"a_e {lib.printed_accel_g:.3g} -> {lib.accel_g:.3g} g"
         )
+    if rep.agreement is not None:
+        click.echo(rep.agreement.headline)
     click.echo(f"{len(rep.errata)} errata entries; report written to {path / 'report.html'}")

@@ -9,28 +9,64 @@ from jinja2 import Environment, PackageLoader, StrictUndefined, select_autoescap
 
 from microg import __version__
 from microg._io import to_jsonable
+from microg.seed.nomenclature import NOMENCLATURE
 from microg.seed.reproduce import Reproduction
 
-__all__ = ["render_reproduction", "environment"]
+__all__ = ["render_reproduction", "environment", "id_ranges"]
+
+
+def id_ranges(ids: list[str]) -> list[tuple[str, str]]:
+    """Errata ids as (label, anchor) runs: ``["E9", "E10", "E11", "E14"]`` ->
+    ``[("E9-E11", "E9"), ("E14", "E14")]``.
+
+    Parameters
+    ----------
+    ids : list of str
+        Ids ``E<n>`` in increasing order.
+    """
+    nums = [int(i[1:]) for i in ids if i[:1] == "E" and i[1:].isdigit()]
+    runs: list[list[int]] = []
+    for n in nums:
+        if runs and n == runs[-1][-1] + 1:
+            runs[-1].append(n)
+        else:
+            runs.append([n])
+    return [(f"E{r[0]}" if len(r) == 1 else f"E{r[0]}-E{r[-1]}", f"E{r[0]}") for r in runs]
 
 
 def environment() -> Environment:
     """The Jinja environment over ``microg/report/templates``."""
-    return Environment(
+    env = Environment(
         loader=PackageLoader("microg.report", "templates"),
         autoescape=select_autoescape(["html"]),
         undefined=StrictUndefined,
     )
+    env.filters["id_ranges"] = id_ranges
+    return env
 
 
 def render_reproduction(
     rep: Reproduction, fig3_uri: str, fig4_uri: str, response_uri: str | None = None
 ) -> str:
-    """HTML of the reproduction with Figures 3, 4 and the point response as data URIs."""
+    """HTML of the reproduction with Figures 3, 4 and the point response as data URIs.
+
+    Parameters
+    ----------
+    rep : Reproduction
+    fig3_uri, fig4_uri : str
+        PNG data URIs of Figures 3 and 4.
+    response_uri : str, optional
+        PNG data URI of the response at the observation point.
+    """
     data = to_jsonable(rep.contract())
     tmpl = environment().get_template("reproduce.html")
     return tmpl.render(
         version=__version__,
+        seed=data["seed_report"],
+        meta=data["meta"],
+        agreement=rep.agreement,
+        comparisons=rep.comparisons,
+        nomenclature=NOMENCLATURE,
         opts=data["options"],
         table4=rep.table4,
         appendix=to_jsonable(rep.appendix_c),

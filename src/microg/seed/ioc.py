@@ -10,6 +10,7 @@ other; the report measures that ``q4`` with the opposite sign (A-6: ``- psi4 q4`
 
 from __future__ import annotations
 
+import re
 import tomllib
 from dataclasses import dataclass
 from functools import cache
@@ -31,6 +32,8 @@ __all__ = [
     "SLUG",
     "LBF",
     "printed",
+    "printed_literals",
+    "half_unit",
     "ReportMatrices",
     "report_reduction",
     "report_matrices",
@@ -51,6 +54,51 @@ def printed() -> dict[str, Any]:
     """The report's printed values (``data/_seed_printed.toml``)."""
     text = resources.files("microg").joinpath("data/_seed_printed.toml").read_text("utf-8")
     return tomllib.loads(text)
+
+
+#: a number literal in a value position of the printed-values file
+_NUMBER = re.compile(
+    r"(?<=[=\[,])(\s*)([+-]?\d[\d_]*(?:\.\d+)?(?:[eE][+-]?\d+)?)(?=\s*(?:[,\]]|$))",
+    re.M,
+)
+
+
+@cache
+def printed_literals() -> dict[str, Any]:
+    """The printed values as their literal text (``"2.730"``, ``"0.254e-8"``), same layout.
+
+    ``tomllib`` turns ``2.730`` into the float 2.73 and loses the printed digit; this reads
+    the file with every number literal quoted, so that :func:`half_unit` sees the digits
+    as printed.  Comments are dropped first (the file has no ``#`` inside strings).
+    """
+    text = resources.files("microg").joinpath("data/_seed_printed.toml").read_text("utf-8")
+    body = "\n".join(line.split("#", 1)[0] for line in text.splitlines())
+    return tomllib.loads(_NUMBER.sub(lambda m: f'{m.group(1)}"{m.group(2)}"', body))
+
+
+def half_unit(text: str) -> float:
+    """Half a unit in the last printed digit of a number literal (the rounding it hides).
+
+    ``"1.0431"`` -> 5e-5, ``"2.730"`` -> 5e-4, ``"0.254e-8"`` -> 5e-12, ``"1096"`` -> 0.5.
+    An integer's trailing zeros are ambiguous: they count as significant up to the fourth
+    significant digit, the precision the report prints its matrices with (``"18900"``, its
+    m11 = 608,600 lb / 32.2 = 18,900.6 slug, -> 5; ``"608600"`` -> 50).
+
+    Parameters
+    ----------
+    text : str
+        A number literal as printed (optional sign, decimals, exponent).
+    """
+    t = text.strip().lstrip("+-").replace("_", "").lower()
+    mant, _, exp = t.partition("e")
+    e = int(exp) if exp else 0
+    if "." in mant:
+        return 0.5 * 10.0 ** (e - len(mant.split(".", 1)[1]))
+    digits = mant.lstrip("0") or "0"
+    zeros = len(digits) - len(digits.rstrip("0"))
+    significant = len(digits) - zeros
+    kept = min(zeros, max(0, 4 - significant))  # trailing zeros read as significant
+    return 0.5 * 10.0 ** (e + zeros - kept)
 
 
 class _Printed(dict):

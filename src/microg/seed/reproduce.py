@@ -3,8 +3,11 @@
 Everything printed is recomputed: Appendix C (w^2, phi, M_jj from the printed matrices;
 the shipped model's matrices element by element), Table 4 (bending frequencies and
 accelerations by Eq. 3.1 with the exact [A]max; libration by Eqs. 2.30 and 3.2) and the
-curves of Figures 3 and 4.  :func:`reproduce` returns a :class:`Reproduction`; the CLI and
-the HTML report only read it.
+curves of Figures 3 and 4.  Each printed value is compared with its recomputation within a
+stated tolerance (:mod:`microg.seed.agreement`), each difference is explained in the errata
+(:mod:`microg.seed.errata`), and the result names the report
+(:data:`microg.seed.source.SEED_REPORT`) and the files it was made from (``meta``).
+:func:`reproduce` returns a :class:`Reproduction`; the CLI and the HTML report only read it.
 """
 
 from __future__ import annotations
@@ -15,11 +18,24 @@ import numpy as np
 
 from microg.dynamics.crew import CrewPushoff, accel_amax, acceleration_a, displacement_u
 from microg.dynamics.dense import solve_dense
+from microg.errors import InputError
 from microg.models.station import Station
+from microg.seed.agreement import (
+    MODEL_BOUND,
+    Agreement,
+    Comparison,
+    build_comparisons,
+    case_solution,
+    libration_route,
+    summarize,
+)
 from microg.seed.condense import condensed_modes
+from microg.seed.eq31 import MAIN_BODY_Z_RANGE_FT, eq31_accel
 from microg.seed.errata import ErrataEntry, build_errata
 from microg.seed.ioc import CASES, FT, LBF, SLUG, printed, report_matrices, report_stiffness_us
 from microg.seed.libration import libration_accel_impulse, libration_frequencies, orbital_rate
+from microg.seed.nomenclature import nomenclature
+from microg.seed.source import SEED_REPORT, SeedReport, reproduction_meta
 from microg.units import G0
 
 __all__ = [
@@ -37,7 +53,7 @@ __all__ = [
 ]
 
 #: relative bound within which a model element counts as matching Appendix C
-MATRIX_BOUND = 0.02
+MATRIX_BOUND = MODEL_BOUND
 
 
 @dataclass(frozen=True)
@@ -52,11 +68,42 @@ class ReproduceOptions:
         Observation point z (from the keel joint), m (the report: -55 ft).
     z_a : float
         Crew force z, m (the report: -55 ft).
+
+    Both points must lie on the rigid main body, z in
+    :data:`microg.seed.eq31.MAIN_BODY_Z_RANGE_FT` (-126.66 to 0 ft): Eq. 3.1 takes the
+    admissible functions there as ``[1, z/l_k, 0, 0]``, which a point on the keel or the
+    boom does not have.
     """
 
     crew: CrewPushoff
     z_e: float
     z_a: float
+
+    def __post_init__(self) -> None:
+        lo, hi = (v * FT for v in MAIN_BODY_Z_RANGE_FT)
+        for name in ("z_e", "z_a"):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, int | float | np.integer | np.floating):
+                raise InputError(f"must be a number, got {v!r}", where=name)
+            if not np.isfinite(v):
+                raise InputError(f"must be finite, got {v}", where=name)
+            if not lo - 1e-9 <= v <= hi + 1e-9:
+                raise InputError(
+                    f"{v / FT:.6g} ft ({v:.6g} m) is not on the rigid main body "
+                    f"({MAIN_BODY_Z_RANGE_FT[0]:g} ft <= z <= {MAIN_BODY_Z_RANGE_FT[1]:g} ft, "
+                    "from the keel joint)",
+                    where=name,
+                    fix="Eq. 3.1 holds on the main body only, where the keel and boom "
+                    "functions vanish; the report's laboratory is at -55 ft",
+                )
+            object.__setattr__(self, name, float(v))
+
+    def is_report(self) -> bool:
+        """Whether these are the report's own inputs (its printed accelerations are for them)."""
+        r = ReproduceOptions.report()
+        mine = (self.crew.f0, self.crew.t1, self.crew.t13, self.crew.t14, self.z_e, self.z_a)
+        theirs = (r.crew.f0, r.crew.t1, r.crew.t13, r.crew.t14, r.z_e, r.z_a)
+        return bool(np.allclose(mine, theirs, rtol=1e-12, atol=0.0))
 
     @classmethod
     def report(cls) -> ReproduceOptions:
@@ -210,7 +257,30 @@ class CurveSet:
 
 @dataclass(frozen=True)
 class Reproduction:
-    """Everything ``microg reproduce`` computes."""
+    """Everything ``microg reproduce`` computes.
+
+    Attributes
+    ----------
+    options : ReproduceOptions
+    appendix_c, table4 : dict
+        Per case (keys of :data:`microg.seed.ioc.CASES`).
+    curves : CurveSet
+        Figures 3 and 4.
+    errata : list of ErrataEntry
+        Every difference (ids ``E1``, ...), the OCR corrections and the errors of the text.
+    model_mass : dict
+        The shipped models' mass properties.
+    point_response : dict
+        Eq. 2.20b at the observation point per case.
+    comparisons : list of Comparison
+        Every printed value compared, with its tolerance and its erratum id.
+    agreement : Agreement or None
+        The comparisons counted per table and appendix.
+    meta : dict
+        Provenance: ``microg_version``, ``created_utc``, ``command``, the seed report's file
+        and sha256, the printed-values file and its sha256, the models read and theirs.
+    seed_report : SeedReport
+    """
 
     options: ReproduceOptions
     appendix_c: dict[str, AppendixCCase]
@@ -219,10 +289,28 @@ class Reproduction:
     errata: list[ErrataEntry]
     model_mass: dict[str, dict[str, float]] = field(default_factory=dict)
     point_response: dict[str, ReportPointResponse] = field(default_factory=dict)
+    comparisons: list[Comparison] = field(default_factory=list)
+    agreement: Agreement | None = None
+    meta: dict = field(default_factory=dict)
+    seed_report: SeedReport = SEED_REPORT
+
+    def to_dict(self) -> dict:
+        """JSON-ready results (the same as :meth:`contract`)."""
+        return self.contract()
 
     def contract(self) -> dict:
-        """The ``--json`` contract: ``appendix_c`` and ``table4`` keyed by case."""
-        out: dict = {"appendix_c": {}, "table4": {}}
+        """The ``--json`` contract: ``seed_report``, ``meta``, ``agreement``, ``comparisons``,
+        ``nomenclature``, then ``appendix_c`` and ``table4`` keyed by case, ``options``,
+        ``errata`` and ``model_mass_properties``."""
+        out: dict = {
+            "seed_report": self.seed_report.to_dict(),
+            "meta": self.meta,
+            "agreement": self.agreement.to_dict() if self.agreement is not None else None,
+            "comparisons": [c.to_dict() for c in self.comparisons],
+            "nomenclature": nomenclature(),
+            "appendix_c": {},
+            "table4": {},
+        }
         for case, ac in self.appendix_c.items():
             out["appendix_c"][case] = {
                 "label": ac.label,
@@ -267,34 +355,19 @@ class Reproduction:
             }
         out["options"] = {
             "f0_lbf": self.options.crew.f0 / LBF,
+            "f0_N": self.options.crew.f0,
             "t1_s": self.options.crew.t1,
             "t13_s": self.options.crew.t13,
             "t14_s": self.options.crew.t14,
             "z_e_ft": self.options.z_e / FT,
+            "z_e_m": self.options.z_e,
             "z_a_ft": self.options.z_a / FT,
+            "z_a_m": self.options.z_a,
+            "report_inputs": self.options.is_report(),
         }
         out["errata"] = [e.__dict__ for e in self.errata]
         out["model_mass_properties"] = self.model_mass
         return out
-
-
-def _rel(a: float, b: float) -> float | None:
-    return None if b == 0 else (a - b) / abs(b)
-
-
-def _accel_eq31(
-    phi: np.ndarray,
-    modal_mass_kg: np.ndarray,
-    omega: np.ndarray,
-    opts: ReproduceOptions,
-    l_k: float,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Eq. 3.1 (Eq. 2.20b per mode): |psi(e) psi(a)| f0 [A]max / (M_jj w t1), m/s^2."""
-    pe = phi[0] + phi[1] * opts.z_e / l_k
-    pa = phi[0] + phi[1] * opts.z_a / l_k
-    amax = accel_amax(omega, opts.crew)
-    acc = np.abs(pe * pa) * opts.crew.f0 * amax / (modal_mass_kg * omega * opts.crew.t1)
-    return acc, amax, pe * pa
 
 
 def _appendix_case(
@@ -333,28 +406,28 @@ def _appendix_case(
     return ac, cm_model.phi, cm_model.modal_mass
 
 
-def _table2_lever(case: str, z: float) -> float:
-    """Distance from Table 2's centre of mass to station z (m); Z = z + 100 ft."""
-    key = "orbiter" if CASES[case][1] else "no_orbiter"
-    cg_z = printed()["table2"][key]["cg_Z"] * FT - 100.0 * FT
-    return cg_z - z
-
-
 def reproduce(
     opts: ReproduceOptions | None = None,
     models: dict[bool, Station] | None = None,
     *,
+    cases: tuple[str, ...] | list[str] | None = None,
+    command: str | None = None,
     curve_omegas: tuple[float, ...] = (0.1, 0.2, 0.3, 0.4),
     curve_tmax: float = 60.0,
 ) -> Reproduction:
-    """Recompute Appendix C, Table 4 and Figures 3-4 of the report.
+    """Recompute Appendix C, Table 4 and Figures 3-4 of the report, compare, and explain.
 
     Parameters
     ----------
     opts : ReproduceOptions, optional
-        Crew force and points (the report's by default).
+        Crew force and points (the report's by default).  With other inputs the printed
+        accelerations (which are for the report's) are shown but not compared.
     models : dict, optional
         ``{True: station with orbiter, False: without}`` (the shipped models by default).
+    cases : sequence of str, optional
+        Cases of :data:`microg.seed.ioc.CASES` (all four by default).
+    command : str, optional
+        The command line, for the provenance (``meta.command``).
     curve_omegas : tuple of float
         Frequencies of Figures 3-4, rad/s.
     curve_tmax : float
@@ -363,30 +436,43 @@ def reproduce(
     from microg.models.toml import load_station
 
     opts = opts or ReproduceOptions.report()
+    chosen = list(CASES) if not cases else [c for c in CASES if c in cases]
+    unknown = sorted(set(cases or ()) - set(CASES))
+    if unknown or not chosen:
+        raise InputError(
+            f"unknown case(s) {unknown}", where="cases", fix=f"choose from {list(CASES)}"
+        )
     if models is None:
         models = {True: load_station("ioc"), False: load_station("ioc-no-orbiter")}
     pr = printed()
-    l_k = pr["constants"]["l_k"] * FT
+    c = pr["constants"]
+    l_k = c["l_k"] * FT
+    k = report_stiffness_us(c["EI"], c["l_k"], c["l_s"])
     appendix: dict[str, AppendixCCase] = {}
     table4: dict[str, Table4Case] = {}
     model_mass: dict[str, dict[str, float]] = {}
-    for case, (plane, orbiter) in CASES.items():
+    omega0: dict[bool, float] = {}
+    for case in chosen:
+        plane, orbiter = CASES[case]
         station = models[orbiter]
         ac, model_phi, model_mm = _appendix_case(case, station, opts)
         appendix[case] = ac
-        omega = np.sqrt(ac.omega2)
-        acc, amax, part = _accel_eq31(ac.phi, ac.modal_mass * SLUG, omega, opts, l_k)
+        sol = case_solution(
+            ac.printed_mass_matrix, k[2, 2], k[3, 3], opts.crew, opts.z_e, opts.z_a, l_k
+        )
         m_omega = np.sqrt(ac.model_omega2)
-        m_acc, _, _ = _accel_eq31(model_phi, model_mm * SLUG, m_omega, opts, l_k)
+        m_acc = eq31_accel(
+            model_phi, model_mm * SLUG, m_omega, opts.crew, opts.z_e, opts.z_a, l_k
+        ).accel
         t4p = pr["table4"][case]
         rows = [
             BendingRow(
-                omega=float(omega[j]),
-                accel_g=float(acc[j] / G0),
+                omega=float(sol.omega[j]),
+                accel_g=float(sol.accel_g[j]),
                 printed_omega=float(t4p["bending_omega"][j]),
                 printed_accel_g=float(t4p["bending_accel_g"][j]),
-                amax=float(amax[j]),
-                participation=float(part[j]),
+                amax=float(sol.amax[j]),
+                participation=float(sol.participation[j]),
                 model_omega=float(m_omega[j]),
                 model_accel_g=float(m_acc[j] / G0),
             )
@@ -394,13 +480,18 @@ def reproduce(
         ]
         # libration: the report's route (Table 2 inertias and centre of mass)
         t2 = pr["table2"]["orbiter" if orbiter else "no_orbiter"]
-        i_t2 = np.array(t2["inertia"], float) * SLUG * FT**2
         w0 = orbital_rate(station.orbit.radius, station.orbit.mu)
+        omega0[orbiter] = w0
+        route = libration_route(
+            np.array(t2["inertia"], float),
+            float(t2["cg_Z"]),
+            plane,
+            w0,
+            opts.crew,
+            opts.z_e,
+            opts.z_a,
+        )
         axis = "y" if plane == "xz" else "x"
-        i_axis = i_t2[1] if plane == "xz" else i_t2[0]
-        w_lib = libration_frequencies(w0, i_t2)[axis]
-        lever_e, lever_a = _table2_lever(case, opts.z_e), _table2_lever(case, opts.z_a)
-        a_lib = libration_accel_impulse(lever_e, lever_a, opts.crew.f0, opts.crew.t1, w_lib, i_axis)
         total, cm, inertia = station.mass_properties()
         mw = libration_frequencies(w0, inertia)[axis]
         mi = inertia[1, 1] if plane == "xz" else inertia[0, 0]
@@ -414,15 +505,15 @@ def reproduce(
             * float(accel_amax(mw, opts.crew))
         )
         lib = LibrationRow(
-            omega=w_lib,
-            accel_g=a_lib / G0,
+            omega=route.omega,
+            accel_g=route.accel_g,
             printed_omega=float(t4p["libration_omega"]),
             printed_accel_g=float(t4p["libration_accel_g"]),
             model_omega=mw,
             model_accel_g=m_lib / G0,
             exact_peak_accel_g=exact / G0,
-            lever_e=lever_e,
-            lever_a=lever_a,
+            lever_e=route.lever_e,
+            lever_a=route.lever_a,
         )
         table4[case] = Table4Case(case, rows, lib, opts.crew.f0 / total / G0)
         model_mass["orbiter" if orbiter else "no_orbiter"] = {
@@ -452,9 +543,33 @@ def reproduce(
         point_response[case] = report_point_response(
             ac.phi, ac.modal_mass * SLUG, np.sqrt(ac.omega2), psi_e, psi_a, opts.crew, t_resp
         )
+    report_inputs = opts.is_report()
+    comparisons = build_comparisons(
+        chosen,
+        opts.crew,
+        opts.z_e,
+        opts.z_a,
+        {case: omega0[CASES[case][1]] for case in chosen},
+        {case: appendix[case].model_mass_matrix for case in chosen},
+        model_mass,
+        report_inputs=report_inputs,
+    )
     rep = Reproduction(opts, appendix, table4, curves, [], model_mass, point_response)
+    errata, comparisons = build_errata(rep, comparisons)
+    meta = reproduction_meta(
+        command, [(st.name, st.source) for o, st in models.items() if o in omega0]
+    )
     return Reproduction(
-        opts, appendix, table4, curves, build_errata(rep), model_mass, point_response
+        opts,
+        appendix,
+        table4,
+        curves,
+        errata,
+        model_mass,
+        point_response,
+        comparisons,
+        summarize(comparisons, report_inputs=report_inputs),
+        meta,
     )
 
 
