@@ -178,3 +178,54 @@ def test_bad_options(tmp_path: Path, csv_file: Path, capsys) -> None:
 def test_out_checked_before_computing(tmp_path: Path, csv_file: Path, capsys) -> None:
     rc, out, err = _run(capsys, ["assess", str(csv_file), "--out", "/proc/x"])
     assert rc == 2 and err.count("\n") == 1 and "--out" in err
+
+
+def test_uff58_file_gives_every_sensor(tmp_path: Path, csv_file: Path, capsys) -> None:
+    from microg.dynamics.response import PointResponse
+    from microg.models.uff import write_uff_time
+
+    n = 12000
+    t = np.arange(n) / FS
+    a = _signal(n)
+    resp = {
+        "lab": PointResponse("lab", t, 0 * a, 0 * a, a),
+        "node-2": PointResponse("node-2", t, 0 * a, 0 * a, 0.5 * a),
+    }
+    uff = write_uff_time(resp, tmp_path / "two.unv", precision="double")
+    rc, out, err = _run(capsys, ["assess", str(uff), "--json"])
+    assert rc == 0, err
+    d = json.loads(out)
+    assert set(d["observations"]) == set(d["intervals"]) == {"lab", "node-2"}
+    assert d["source"]["format"] == "uff58" and set(d["source"]["sensors"]) == {"lab", "node-2"}
+    rc, out2, _ = _run(capsys, ["assess", str(csv_file), "--json"])
+    base = json.loads(out2)["observations"]["sensor"]
+    # reference: the same accelerations read from the CSV (17 digits) by the CSV reader;
+    # the UFF's E20.12 keeps 13 digits: the band RMS agree to 1e-9
+    lab = d["observations"]["lab"]
+    assert np.allclose(lab["third_octave"]["rms_g"], base["third_octave"]["rms_g"], rtol=1e-9)
+    half = d["observations"]["node-2"]["third_octave"]["rms_g"]
+    assert np.allclose(half, 0.5 * np.asarray(base["third_octave"]["rms_g"]), rtol=1e-9)
+    assert d["complies"] is (lab["complies"] and d["observations"]["node-2"]["complies"])
+    rc, out, err = _run(capsys, ["assess", str(uff)])
+    assert rc == 0 and out.count("two.unv: ") == 2 and "lab (UFF58" in out
+    # --sensor renames one record only
+    err = _bad(tmp_path, capsys, [str(uff), "--sensor", "x"], "--sensor")
+    assert "holds 2 sensors" in err
+
+
+def test_bad_uff58_input(tmp_path: Path, capsys) -> None:
+    from microg.dynamics.response import PointResponse
+    from microg.models.uff import write_uff_time
+
+    t = np.arange(200) / FS
+    a = _signal(200)
+    uff = write_uff_time(
+        {"lab": PointResponse("lab", t, a, a, a)}, tmp_path / "v.unv", quantity="velocity"
+    )
+    err = _bad(tmp_path, capsys, [str(uff)], "dataset 58 #1")
+    assert "v.unv" in err and "not acceleration" in err
+    text = write_uff_time({"lab": PointResponse("lab", t, a, a, a)}, tmp_path / "a.unv").read_text()
+    cut = tmp_path / "cut.unv"
+    cut.write_text(text[: text.rindex("    -1\n    58")])  # the z record missing
+    err = _bad(tmp_path, capsys, [str(cut)], "dataset 58 #1")
+    assert "has no z axis" in err

@@ -12,7 +12,7 @@ import click
 
 from microg.cli.params import QuantityType
 
-__all__ = ["assess"]
+__all__ = ["assess", "merge_assessments", "run_assessment"]
 
 #: library parameter -> command-line option, for error messages
 FLAGS = {
@@ -63,7 +63,9 @@ FLAGS = {
     help="Transient criteria set (iss, report-1e-5g) or 'none'.",
 )
 @click.option(
-    "--sensor", default=None, help="Name of the record in the output. [default: the file's]"
+    "--sensor",
+    default=None,
+    help="Name of the record in the output (files of one record). [default: the file's]",
 )
 @click.option("--json", "as_json", is_flag=True, help="Print the results as JSON to stdout.")
 @click.option(
@@ -87,13 +89,15 @@ def assess(
     """Assess a measured acceleration record FILE against a requirement.
 
     FILE is a PIMS/SAMS PAD data file (32-bit little-endian floats t, x, y, z in g, with its
-    .header beside it) or a CSV with units in its header (time [s], x [m/s^2], y [g], z [ug]).
-    Prints the band verdict, the PIMS-style interval statistics and the transient criteria;
-    --json prints the observations contract of `microg analyze`, keyed by sensor name.
+    .header beside it), a CSV with units in its header (time [s], x [m/s^2], y [g], z [ug]),
+    or a UFF file of time histories (.unv/.uff, datasets 58 with 164 units: x, y, z of each
+    node, every sensor assessed).  Prints the band verdict, the PIMS-style interval
+    statistics and the transient criteria; --json prints the observations contract of
+    `microg analyze`, keyed by sensor name.
     """
     from microg._io import check_writable, dumps
     from microg.cli._errors import flag_errors
-    from microg.environment.measured import read_measured
+    from microg.environment.measured import read_measured_all
 
     ctx = click.get_current_context()
     explicit_interval = (
@@ -102,29 +106,78 @@ def assess(
     with flag_errors(FLAGS):
         if out_dir is not None:
             check_writable(out_dir, "out")  # before computing anything
-        record = read_measured(file)
-        result = run_assessment(
-            record,
-            interval_s=interval,
-            explicit_interval=explicit_interval,
-            requirement=requirement,
-            psd_method=psd_method,
-            segment_s=segment,
-            transient=None if transient.strip().lower() == "none" else transient,
-            sensor=sensor,
-        )
-        payload = result["json"]
+        records = read_measured_all(file)
+        if sensor is not None and len(records) > 1:
+            from microg.errors import InputError
+
+            raise InputError(
+                f"names a single record; {file} holds {len(records)} sensors "
+                f"({', '.join(r.key for r in records)})",
+                where="--sensor",
+                fix="leave it out: each sensor keeps its name",
+            )
+        results = [
+            run_assessment(
+                record,
+                interval_s=interval,
+                explicit_interval=explicit_interval,
+                requirement=requirement,
+                psd_method=psd_method,
+                segment_s=segment,
+                transient=None if transient.strip().lower() == "none" else transient,
+                sensor=sensor,
+            )
+            for record in records
+        ]
+        payload = merge_assessments(results)
         if out_dir is not None:
             from microg._io import write_output_files
 
-            files = {**_figures(result), "results.json": dumps(payload)}
+            files: dict[str, bytes | str] = {"results.json": dumps(payload)}
+            for r in results:
+                files.update(_figures(r))
             path = write_output_files(out_dir, files, where="out")
     if as_json:
         click.echo(dumps(payload))
     else:
-        _summary(result)
+        for r in results:
+            _summary(r)
         if out_dir is not None:
             click.echo(f"written to {path}")
+
+
+def merge_assessments(results: list[dict[str, Any]]) -> dict[str, Any]:
+    """One ``--json`` document for the sensors of one file (each a :func:`run_assessment`).
+
+    ``observations`` and ``intervals`` are keyed by sensor; ``complies`` holds for all of
+    them; ``warnings`` carry the sensor's name when the file has several.  With one sensor
+    the document is that sensor's own.
+    """
+    if len(results) == 1:
+        return results[0]["json"]
+    docs = [r["json"] for r in results]
+    keys = [r["key"] for r in results]
+    if len(set(keys)) != len(keys):
+        from microg.errors import InputError
+
+        raise InputError(
+            "two sensors of the file have one name", where=str(results[0]["record"].path)
+        )
+    first = results[0]["record"]
+    return {
+        "meta": docs[0]["meta"],
+        "source": {
+            "path": first.path,
+            "format": first.format,
+            "sensors": {k: d["source"] for k, d in zip(keys, docs, strict=True)},
+        },
+        "requirement": docs[0]["requirement"],
+        "requirement_source": docs[0]["requirement_source"],
+        "observations": {k: d["observations"][k] for k, d in zip(keys, docs, strict=True)},
+        "intervals": {k: d["intervals"][k] for k, d in zip(keys, docs, strict=True)},
+        "complies": all(bool(d["complies"]) for d in docs),
+        "warnings": [f"{k}: {w}" for k, d in zip(keys, docs, strict=True) for w in d["warnings"]],
+    }
 
 
 def run_assessment(
@@ -161,7 +214,7 @@ def run_assessment(
         cutoff_hz=record.cutoff_hz,
         sample_rate_hz=record.sample_rate_hz,
     )
-    warnings = list(a.warnings)
+    warnings = list(getattr(record, "warnings", ())) + list(a.warnings)
     length = interval_s
     if record.duration_s < interval_s and not explicit_interval:
         length = record.duration_s

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import io
 import json
+import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -43,6 +44,8 @@ from microg.models.modal import (
 
 __all__ = [
     "UffDataset",
+    "data_values",
+    "dataset_units",
     "read_uff",
     "modal_model_from_uff",
     "write_uff_modes",
@@ -70,6 +73,14 @@ def read_uff(path: str | Path) -> list[UffDataset]:
         raise InputError("no such file", where=label) from None
     except OSError as exc:
         raise InputError(f"cannot read: {exc.strerror or exc}", where=label) from None
+    binary = re.search(r"^\s*-1[ \t]*\r?\n[ \t]*(\d+)[bB]", text, re.MULTILINE)
+    if binary:
+        line = text.count("\n", 0, binary.start(1)) + 1
+        raise InputError(
+            f"line {line}: dataset {binary.group(1)}b is binary UFF, which microg does not read",
+            where=label,
+            fix="write the file as ASCII UFF (pyuff: binary=0)",
+        )
     lines = text.splitlines()
     marks = [i for i, ln in enumerate(lines) if ln.strip() == "-1"]
     if len(marks) < 2:
@@ -97,11 +108,28 @@ def _numbers(lines: Sequence[str], where: str) -> np.ndarray:
 
 
 def _fixed(lines: Sequence[str], width: int) -> np.ndarray:
-    vals = []
+    vals: list[float] = []
     for ln in lines:
         s = ln.rstrip()
         vals.extend(float(s[i : i + width].replace("D", "E")) for i in range(0, len(s), width))
     return np.array(vals)
+
+
+def data_values(lines: Sequence[str], where: str, width: int) -> np.ndarray:
+    """Numbers of a data section: whitespace-separated, or ``width``-wide fields that touch."""
+    try:
+        return _numbers(lines, where)
+    except InputError:
+        pass
+    try:
+        return _fixed(lines, width)
+    except ValueError:
+        raise InputError("non-numeric data", where=where) from None
+
+
+def dataset_units(ds: UffDataset, where: str) -> UnitSystem:
+    """The unit system of a dataset 164 (SI value = file value / factor)."""
+    return _units164(ds, where)
 
 
 def _units164(ds: UffDataset, where: str) -> UnitSystem:
