@@ -113,6 +113,11 @@ def test_own_npz_file_gives_the_same_map(exported, tmp_path):
     # the own file stores the model's arrays bit for bit
     np.testing.assert_array_equal(a.total_peak, b.total_peak)
     np.testing.assert_array_equal(a.per_mode, b.per_mode)
+    # the model object itself (microg.load_model's result) takes the same path
+    c = locate(load_model(uff, points=pts), crew="crew").amap
+    np.testing.assert_array_equal(a.total_peak, c.total_peak)
+    ds = c.to_xarray()
+    assert list(ds["label"].values[:2]) == ["grid:1", "grid:2"]
 
 
 def test_crew_grid_and_errors(exported):
@@ -238,6 +243,8 @@ def test_deck_lines_and_nodes_follow_the_elements(truss):
     deck, graph = truss
     res = locate(deck, units="mm, N, s", crew="grid:1", direction="x")
     amap = res.amap
+    # the GraphModel object takes the same path as its deck
+    np.testing.assert_array_equal(locate(graph, crew="grid:1").amap.total_peak, amap.total_peak)
     # 12 CBARs + 5 CRODs, no two collinear through a node: 17 one-element lines
     assert len(amap.lines) == 17
     ends = {tuple(sorted(amap.labels[ln.index[[0, -1]]])) for ln in amap.lines}

@@ -258,7 +258,8 @@ def _unit_system(station: Any, model: str) -> str | None:
     "--on",
     "component",
     default=None,
-    help="Restrict the best location to this body or beam (e.g. main).",
+    help="Restrict the best location to this body or beam (e.g. main); imported models: "
+    "points (the named points), grids (a modal model's grids) or grid (a deck's nodes).",
 )
 @click.option(
     "--measure",

@@ -7,6 +7,11 @@ elastic rule), :mod:`~microg.location.amap` (the acceleration map, the peaks at 
 the best location, :func:`locate`), :mod:`~microg.location.layout` (movable masses and the
 optimiser); figures in :mod:`microg.plotting.location`, the conclusion-7 reproduction in
 :mod:`microg.seed.conclusion7`.  See ``docs/locate.md``.
+
+:func:`locate` takes stations and imported models alike: a modal model is mapped over its
+grids (named points added as carrier ``"points"``), a NASTRAN deck over its nodes, with the
+nodes of the fundamental along the straight chains of its beams and rods
+(:func:`~microg.location.sampling.element_lines`).
 """
 
 from microg.location.amap import (

@@ -312,6 +312,7 @@ class AccelerationMap:
             "axis": ["x", "y", "z"],
             "mode": np.arange(self.omega.size),
             "component": ("sample", self.component.astype(str)),
+            **({} if self.labels is None else {"label": ("sample", self.labels.astype(str))}),
             "omega": ("mode", self.omega, {"units": "rad/s"}),
             "rigid": ("mode", self.rigid),
             "elastic": ("mode", self.elastic),
