@@ -103,33 +103,58 @@ def _run(argv: list[str], env: dict[str, str]) -> tuple[float, float, bytes]:
     return wall, cpu, proc.stdout
 
 
-def timings(runs: int, tmp: Path) -> dict[str, dict[str, float]]:
+#: the analyze row run through :data:`_PROPOSED_DRIVER` while the CLI is not wired
+PROPOSED = "microg analyze --json (helpers)"
+
+#: ``microg analyze`` with the renderer wired as proposed for cli/analyze.py
+_PROPOSED_DRIVER = """
+import sys
+import microg.cli.analyze
+import microg.report.analysis as rep
+from microg.cli import main
+renderer = rep.start_renderer()
+_figures = rep.figures
+rep.figures = lambda result, renderer_=None: _figures(result, renderer_ or renderer)
+code = main(sys.argv[1:])
+renderer.close()
+sys.exit(code)
+"""
+
+
+def timings(runs: int, tmp: Path, proposed: bool = False) -> dict[str, dict[str, float]]:
     """Median wall and CPU time of each command over ``runs`` round-robin runs."""
     py = sys.executable
     mg = _microg_command()
-    env = {**os.environ, "PYTHONDONTWRITEBYTECODE": "0"}
+    env = {**os.environ}
+    analyze = "microg analyze --json"
     cases: dict[str, list[str]] = {
         "python -c 'import numpy'": [py, "-c", "import numpy"],
         "import microg": [py, "-c", "import microg"],
         "microg modes ioc --json": [*mg, "modes", "ioc", "--json"],
-        "microg analyze --json": [],  # a fresh --out per run, below
+        analyze: [*mg, "analyze"],
     }
+    if proposed:
+        cases[PROPOSED] = [py, "-c", _PROPOSED_DRIVER, "analyze"]
     walls: dict[str, list[float]] = {k: [] for k in cases}
     cpus: dict[str, list[float]] = {k: [] for k in cases}
+
+    def argv_of(name: str, out: Path) -> list[str]:
+        argv = cases[name]
+        if name in (analyze, PROPOSED):  # a fresh --out per run
+            argv = [*argv, "--json", "--no-progress", "--out", str(out)]
+        return argv
+
     # one untimed round: byte-compiled files and the page cache as a user's second run has them
-    for name, argv in cases.items():
-        if name == "microg analyze --json":
-            argv = [*mg, "analyze", "--json", "--no-progress", "--out", str(tmp / "warm")]
-        _run(argv, env)
+    for name in cases:
+        _run(argv_of(name, tmp / "warm"), env)
     for r in range(runs):
-        for name, argv in cases.items():
-            if name == "microg analyze --json":
-                argv = [*mg, "analyze", "--json", "--no-progress", "--out", str(tmp / f"run{r}")]
-            wall, cpu, out = _run(argv, env)
-            if name == "microg analyze --json":
-                data = json.loads(out)
+        for k, name in enumerate(cases):
+            out = tmp / f"run{r}-{k}"
+            wall, cpu, stdout = _run(argv_of(name, out), env)
+            if name in (analyze, PROPOSED):
+                data = json.loads(stdout)
                 assert "observations" in data, "analyze --json printed no observations"
-                assert (tmp / f"run{r}" / "report.html").is_file(), "no report.html written"
+                assert (out / "report.html").is_file(), "no report.html written"
             walls[name].append(wall)
             cpus[name].append(cpu)
     return {
@@ -147,14 +172,18 @@ def forbidden_imports() -> list[str]:
 # ------------------------------------------------------------------------- stage profile
 
 
-def _profile_child(out_dir: str, per_figure: bool) -> dict[str, Any]:
-    """One in-process run of what ``microg analyze --json`` does, timed stage by stage."""
-    stamps: list[tuple[str, float, set[str]]] = []
+def _profile_child(out_dir: str, per_figure: bool, helpers: bool) -> dict[str, Any]:
+    """One in-process run of what ``microg analyze --json`` does, timed stage by stage.
+
+    ``helpers``: the figures are drawn by :func:`microg.report.analysis.start_renderer`'s
+    helper processes, started where the command starts them (before the computation).
+    """
+    stamps: list[tuple[str, float, float, set[str]]] = []
 
     def mark(stage: str) -> None:
-        stamps.append((stage, time.perf_counter(), set(sys.modules)))
+        stamps.append((stage, time.perf_counter(), time.process_time(), set(sys.modules)))
 
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     mods0 = set(sys.modules)
     import tqdm  # noqa: F401  (the command imports it before it computes)
 
@@ -162,56 +191,61 @@ def _profile_child(out_dir: str, per_figure: bool) -> dict[str, Any]:
     import microg.cli
     import microg.cli.analyze as cli_analyze
 
-    stamps.append(("model load", time.perf_counter(), set(sys.modules)))
+    mark("model load")
     import microg.analysis as an
     import microg.report.analysis as rep
 
-    extra: dict[str, float] = {"exact peaks": 0.0, "figure render": 0.0}
+    renderer = rep.start_renderer() if helpers else None
+    extra: dict[str, float] = {"exact peaks": 0.0, "exact peaks cpu": 0.0}
     figure_times: dict[str, float] = {}
 
-    def timed(fn: Any, key: str) -> Any:
+    def timed(fn: Any) -> Any:
         def wrapper(*args: Any, **kwargs: Any) -> Any:
-            t = time.perf_counter()
+            t, c = time.perf_counter(), time.process_time()
             try:
                 return fn(*args, **kwargs)
             finally:
-                extra[key] += time.perf_counter() - t
+                extra["exact peaks"] += time.perf_counter() - t
+                extra["exact peaks cpu"] += time.process_time() - c
 
         return wrapper
 
-    an.peak_response = timed(an.peak_response, "exact peaks")  # type: ignore[attr-defined]
-
-    def png_timed(png: Any) -> Any:
-        def wrapper(fig: Any, *args: Any, **kwargs: Any) -> bytes:
-            t = time.perf_counter()
-            try:
-                return png(fig, *args, **kwargs)
-            finally:
-                dt = time.perf_counter() - t
-                extra["figure render"] += dt
-                if per_figure:
-                    axes = fig.get_axes()
-                    title = axes[0].get_title() if axes else ""
-                    figure_times[f"{len(figure_times):02d} {title}"[:60]] = dt
-
-        return wrapper
+    an.peak_response = timed(an.peak_response)  # type: ignore[attr-defined]
 
     def staged(name: str, fn: Any) -> Any:
         def wrapper(*args: Any, **kwargs: Any) -> Any:
             mark(name)
-            if name == "figures":  # the figure modules load here, as in the command
-                import microg.plotting.common as common
-
-                common.png_bytes = png_timed(common.png_bytes)  # type: ignore[assignment]
             try:
+                if name == "figures" and renderer is not None and len(args) < 2:
+                    kwargs.setdefault("renderer", renderer)
                 return fn(*args, **kwargs)
             finally:
                 mark("write")
 
         return wrapper
 
+    def jobs_timed(fn: Any) -> Any:
+        def wrapper(result: Any) -> Any:
+            from microg.report.render import FigureJob
+
+            def clock(job: Any) -> Any:
+                def draw() -> bytes:
+                    t = time.perf_counter()
+                    try:
+                        return bytes(job.draw())
+                    finally:
+                        figure_times[job.name] = time.perf_counter() - t
+
+                return FigureJob(job.name, job.weight, draw)
+
+            return [clock(j) for j in fn(result)]
+
+        return wrapper
+
     rep.figures = staged("figures", rep.figures)  # type: ignore[assignment]
     rep.render_analysis = staged("HTML", rep.render_analysis)  # type: ignore[assignment]
+    if per_figure:
+        rep.figure_jobs = jobs_timed(rep.figure_jobs)  # type: ignore[assignment]
 
     result = microg.analyze(progress=mark, command="microg analyze --json")
     mark("write")
@@ -219,26 +253,36 @@ def _profile_child(out_dir: str, per_figure: bool) -> dict[str, Any]:
     from microg._io import dumps
 
     dumps(result.to_dict())  # what --json prints
-    t_end = time.perf_counter()
+    mark("end")
+    if renderer is not None:
+        renderer.close()
 
     # stage durations from consecutive stamps; "write" collects the time outside figures/HTML
-    times: dict[str, float] = {s: 0.0 for s in STAGES}
+    wall: dict[str, float] = {s: 0.0 for s in STAGES}
+    cpu: dict[str, float] = {s: 0.0 for s in STAGES}
     loaded: dict[str, list[str]] = {s: [] for s in STAGES}
-    times["imports"] = stamps[0][1] - t0
-    loaded["imports"] = [m for m in WATCH if m in stamps[0][2] - mods0]
-    seq = [*stamps, ("end", t_end, set(sys.modules))]
-    for (stage, t, mods), (_, t_next, mods_next) in zip(seq[:-1], seq[1:], strict=True):
-        key = stage if stage in times else "write"
-        times[key] += t_next - t
+    wall["imports"] = stamps[0][1] - t0
+    cpu["imports"] = stamps[0][2] - c0
+    loaded["imports"] = [m for m in WATCH if m in stamps[0][3] - mods0]
+    for (stage, t, c, mods), (_, t_next, c_next, mods_next) in zip(
+        stamps[:-1], stamps[1:], strict=True
+    ):
+        key = stage if stage in wall else "write"
+        wall[key] += t_next - t
+        cpu[key] += c_next - c
         loaded[key] += [m for m in WATCH if m in mods_next - mods]
-    times["assessment"] -= extra["exact peaks"]
-    times["exact peaks"] = extra["exact peaks"]
+    wall["assessment"] -= extra["exact peaks"]
+    wall["exact peaks"] = extra["exact peaks"]
+    cpu["assessment"] -= extra["exact peaks cpu"]
+    cpu["exact peaks"] = extra["exact peaks cpu"]
     return {
-        "times": times,
-        "total": t_end - t0,
-        "render": extra["figure render"],
+        "wall": wall,
+        "cpu": cpu,
+        "total": stamps[-1][1] - t0,
+        "total cpu": stamps[-1][2] - c0,
         "loaded": loaded,
         "figures": figure_times,
+        "helpers": renderer is not None and renderer.error is None,
         "threads": _blas_threads(),
     }
 
@@ -251,7 +295,7 @@ def _blas_threads() -> str:
     return ", ".join(f"{i['internal_api']} {i['num_threads']}" for i in threadpool_info()) or "-"
 
 
-def profile(runs: int, tmp: Path, per_figure: bool) -> list[dict[str, Any]]:
+def profile(runs: int, tmp: Path, per_figure: bool, helpers: bool) -> list[dict[str, Any]]:
     """The stage profile of ``runs`` fresh processes."""
     out = []
     for r in range(runs):
@@ -259,8 +303,9 @@ def profile(runs: int, tmp: Path, per_figure: bool) -> list[dict[str, Any]]:
             sys.executable,
             __file__,
             "--child",
-            str(tmp / f"profile{r}"),
+            str(tmp / f"profile{r}-{int(helpers)}"),
             *(["--figures"] if per_figure else []),
+            *(["--helpers"] if helpers else []),
         ]
         proc = subprocess.run(argv, capture_output=True, check=False)
         if proc.returncode != 0:
@@ -274,16 +319,26 @@ def _median_of(rows: list[dict[str, Any]], key: str, sub: str | None = None) -> 
     return statistics.median(vals)
 
 
+def cli_uses_helpers() -> bool:
+    """Whether ``microg analyze`` hands a renderer to ``write_outputs`` (issue 8 wiring)."""
+    import inspect
+
+    import microg.cli.analyze as cli_analyze
+
+    return "renderer" in inspect.signature(cli_analyze.write_outputs).parameters
+
+
 def main() -> None:
     """Run the benchmark and print the table and the profile."""
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
     ap.add_argument("--runs", type=int, default=5, help="runs of each command (median)")
     ap.add_argument("--profile-runs", type=int, default=3, help="fresh processes profiled")
-    ap.add_argument("--figures", action="store_true", help="also time each figure")
+    ap.add_argument("--figures", action="store_true", help="also time each figure (in-process)")
     ap.add_argument("--child", help=argparse.SUPPRESS)
+    ap.add_argument("--helpers", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.child:
-        print(json.dumps(_profile_child(args.child, args.figures)))
+        print(json.dumps(_profile_child(args.child, args.figures, args.helpers)))
         return
 
     tmp = Path(tempfile.mkdtemp(prefix="bench_cli-"))
@@ -292,46 +347,65 @@ def main() -> None:
             f"python {sys.version.split()[0]}, {os.cpu_count()} CPUs, load average "
             f"{' '.join(f'{x:.2f}' for x in os.getloadavg())}"
         )
-        res = timings(args.runs, tmp)
+        wired = cli_uses_helpers()
+        res = timings(args.runs, tmp, proposed=not wired)
         base = res["python -c 'import numpy'"]
         print(f"\nmedian of {args.runs} fresh processes (round-robin with the baseline)")
         print(
-            f"{'command':<28} {'wall [s]':>9} {'ratio':>7} {'target':>7} {'cpu [s]':>8}"
+            f"{'command':<40} {'wall [s]':>9} {'ratio':>7} {'target':>7} {'cpu [s]':>8}"
             f" {'cpu ratio':>9}"
         )
         for name, t in res.items():
-            target = TARGETS.get(name)
+            target = TARGETS.get(name, TARGETS.get(name.split(" (")[0]))
             ratio = t["wall"] / base["wall"]
             flag = "" if target is None else ("  ok" if ratio <= target else "  OVER")
             print(
-                f"{name:<28} {t['wall']:>9.3f} {ratio:>6.2f}x "
+                f"{name:<40} {t['wall']:>9.3f} {ratio:>6.2f}x "
                 f"{'' if target is None else f'{target:.0f}x':>7} {t['cpu']:>8.3f} "
                 f"{t['cpu'] / base['cpu']:>8.2f}x{flag}"
+            )
+        if not wired:
+            print(
+                f"  {PROPOSED!r}: microg analyze with the figures drawn by helper processes "
+                "started before the computation (microg.report.analysis.start_renderer), as "
+                "cli/analyze.py would do it (cpu includes the helpers)"
             )
         bad = forbidden_imports()
         listed = ", ".join(bad) if bad else "none of " + ", ".join(FORBIDDEN)
         print(f"import microg loads {listed}")
 
-        rows = profile(args.profile_runs, tmp, args.figures)
+        serial = profile(args.profile_runs, tmp, args.figures, helpers=False)
+        helped = profile(args.profile_runs, tmp, False, helpers=True)
         print(
-            f"\nmicrog analyze, stage by stage (median of {len(rows)} fresh processes; "
-            f"BLAS: {rows[0]['threads']})"
+            f"\nmicrog analyze, stage by stage (median of {len(serial)} fresh processes each; "
+            f"BLAS: {serial[0]['threads']})"
+        )
+        print(
+            f"  {'stage':<12} {'wall [s]':>9} {'cpu [s]':>8} {'helpers: wall':>14}"
+            "   (first loaded in the stage)"
         )
         for stage in STAGES:
-            t = _median_of(rows, "times", stage)
-            libs = sorted({m for r in rows for m in r["loaded"][stage]})
-            note = f"  loads {', '.join(libs)}" if libs else ""
-            if stage == "figures":
-                note = f"  (rendering {_median_of(rows, 'render'):.3f} s){note}"
-            print(f"  {stage:<12} {t:>7.3f} s{note}")
+            libs = sorted({m for r in serial for m in r["loaded"][stage]})
+            note = f"   {', '.join(libs)}" if libs else ""
+            print(
+                f"  {stage:<12} {_median_of(serial, 'wall', stage):>9.3f} "
+                f"{_median_of(serial, 'cpu', stage):>8.3f} "
+                f"{_median_of(helped, 'wall', stage):>14.3f}{note}"
+            )
         print(
-            f"  {'total':<12} {_median_of(rows, 'total'):>7.3f} s (in-process, without the "
-            "interpreter start)"
+            f"  {'total':<12} {_median_of(serial, 'total'):>9.3f} "
+            f"{_median_of(serial, 'total cpu'):>8.3f} {_median_of(helped, 'total'):>14.3f}"
+            "   (in-process, without the interpreter start)"
+        )
+        used = sum(bool(r["helpers"]) for r in helped)
+        print(
+            f"  helpers: figures drawn by forked helper processes in {used} of {len(helped)} "
+            "runs (their wall time is the caller's wait)"
         )
         if args.figures:
-            print("\nrendering of each figure (median, s)")
-            for name in rows[0]["figures"]:
-                vals = [r["figures"].get(name, float("nan")) for r in rows]
+            print("\ndrawing of each figure, in-process (median, s)")
+            for name in serial[0]["figures"]:
+                vals = [r["figures"].get(name, float("nan")) for r in serial]
                 print(f"  {statistics.median(vals):7.3f}  {name}")
     finally:
         shutil.rmtree(tmp, ignore_errors=True)

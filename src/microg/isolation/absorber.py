@@ -28,7 +28,6 @@ from typing import Literal
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy import integrate, linalg, optimize
 
 from microg.errors import InputError, SolverError
 from microg.isolation.transmissibility import accel_magnification, spring_ratio_from_tuning
@@ -179,6 +178,8 @@ def peak_over_band(
     for i in cands:
         if i in (0, r.size - 1):
             continue
+        from scipy import optimize  # here: scipy.optimize costs ~0.2 s to import
+
         res = optimize.minimize_scalar(
             lambda x: -float(accel_magnification(k, mu, zeta, x)),
             bounds=(float(r[i - 1]), float(r[i + 1])),
@@ -236,9 +237,13 @@ def h2_integral(k: float, mu: float, zeta: float, band: tuple[float, float] | No
     if zeta <= 0.0:
         return math.inf
     if band is None:
+        from scipy import linalg
+
         A, B, C = dimensionless_state_space(k, mu, zeta)
         P = linalg.solve_continuous_lyapunov(A, -B @ B.T)
         return float(math.pi * (C @ P @ C.T)[0, 0])
+    from scipy import integrate  # here: scipy.integrate costs ~0.1 s to import
+
     lo, hi = band
     pts = sorted({lo, hi, *(x for x in _resonance_candidates(k, mu) if lo < x < hi)})
     total = 0.0
@@ -387,6 +392,8 @@ def tune_absorber(
     if zeta == 0.0 and criterion == "h2":
         raise InputError("H2 of an undamped absorber is infinite", where="zeta", fix="use zeta > 0")
     zeta_fixed = None if zeta is None else float(zeta)
+    from scipy import optimize  # here: scipy.optimize costs ~0.2 s to import
+
     closed = den_hartog(mu) if criterion == "peak" else h2_closed_form(mu)
     starts = [(math.log(closed.f), math.log(closed.zeta))]
     starts += _coarse_grid(mu, band, criterion, zeta_fixed)

@@ -27,9 +27,12 @@ from typing import Any
 
 import numpy as np
 from matplotlib import rcParams
+from matplotlib.artist import Artist
+from matplotlib.collections import LineCollection
 from matplotlib.figure import Figure
 from matplotlib.font_manager import FontProperties
-from matplotlib.ticker import LogFormatterSciNotation
+from matplotlib.lines import Line2D
+from matplotlib.ticker import LogFormatterSciNotation, NullLocator
 
 __all__ = [
     "ENVELOPE_BINS",
@@ -160,6 +163,7 @@ def finish(fig: Figure, **margins: float) -> Figure:
             if scale == "log":
                 axis.set_major_formatter(PlainLogFormatter())
                 axis.set_minor_formatter(PlainLogFormatter(labelOnlyBase=False))
+                _lean_minor_ticks(ax, axis)
     if fig.get_layout_engine() is not None:
         return fig
     left = margins.pop("left", _MARGINS["left"])
@@ -203,6 +207,78 @@ def _char_em(c: str) -> float:
     if c in "\u2070\u00b9\u00b2\u00b3\u2074\u2075\u2076\u2077\u2078\u2079\u207b":
         return 0.42
     return _CHAR_EM.get(c, 0.72)
+
+
+class _MinorTicks(Artist):
+    """The minor ticks and grid lines of a log axis drawn as two artists instead of one
+    :class:`~matplotlib.axis.Tick` (five artists) per tick, styled as the axis' own ticks."""
+
+    def __init__(self, ax: Any, axis: Any, locator: Any, grid: Any, mark: Any) -> None:
+        super().__init__()
+        self._ax, self._axis, self._locator = ax, axis, locator
+        self._grid = grid  # the template tick's grid line (None: no minor grid)
+        self._mark = mark  # the template tick's tick mark (None: not drawn)
+        self.set_zorder(axis.get_zorder())
+
+    def draw(self, renderer: Any) -> None:
+        """Draw the marks and grid lines at the minor locations in view."""
+        lo, hi = sorted(self._axis.get_view_interval())
+        major = np.log10(np.asarray(self._axis.get_majorticklocs(), float))
+        locs = np.asarray(self._locator(), float)
+        locs = locs[(locs >= lo) & (locs <= hi)]
+        if major.size and locs.size:  # as matplotlib: no minor tick on a major one
+            close = np.abs(np.log10(locs)[:, None] - major[None, :]).min(axis=1) < 1e-9
+            locs = locs[~close]
+        if not locs.size:
+            return
+        is_x = self._axis is self._ax.xaxis
+        trans = self._ax.get_xaxis_transform() if is_x else self._ax.get_yaxis_transform()
+        if self._grid is not None:
+            g = self._grid
+            segs = [[(v, 0.0), (v, 1.0)] if is_x else [(0.0, v), (1.0, v)] for v in locs]
+            lines = LineCollection(
+                segs,
+                colors=[g.get_color()],
+                linewidths=g.get_linewidth(),
+                linestyles=g.get_linestyle(),
+                alpha=g.get_alpha(),
+                transform=trans,
+            )
+            lines.set_figure(self._ax.figure)
+            lines.set_clip_path(self._ax.patch)
+            lines.draw(renderer)
+        if self._mark is not None:
+            m = self._mark
+            xy = (locs, np.zeros_like(locs)) if is_x else (np.zeros_like(locs), locs)
+            marks = Line2D(
+                *xy,
+                linestyle="none",
+                marker=m.get_marker(),
+                markersize=m.get_markersize(),
+                markeredgewidth=m.get_markeredgewidth(),
+                color=m.get_color(),
+                transform=trans,
+                clip_on=False,
+            )
+            marks.set_figure(self._ax.figure)
+            marks.draw(renderer)
+
+
+def _lean_minor_ticks(ax: Any, axis: Any) -> None:
+    """Replace a log axis' minor Tick objects by one :class:`_MinorTicks` artist.
+
+    Only where the axis spans more than 1.5 decades: there matplotlib labels no minor tick,
+    so the drawing is the same (marks and grid lines in the axis' own style).
+    """
+    lo, hi = sorted(axis.get_view_interval())
+    if not (lo > 0 and np.log10(hi / lo) > 1.5):
+        return
+    template = axis.get_minor_ticks(1)[0]
+    grid = template.gridline if template.gridline.get_visible() else None
+    mark = template.tick1line if template.tick1line.get_visible() else None
+    locator = axis.get_minor_locator()
+    axis.set_minor_locator(NullLocator())
+    ax.add_artist(_MinorTicks(ax, axis, locator, grid, mark))
 
 
 def envelope(

@@ -30,13 +30,19 @@ _FLOOR = 1e-30
 
 
 def _figure(title: str) -> Any:
-    from matplotlib.figure import Figure
+    from microg.plotting.common import new_figure
 
-    fig = Figure(figsize=(7.5, 4.5), layout="constrained")
+    fig = new_figure(7.5, 4.5)
     ax = fig.add_subplot()
     if title:
         ax.set_title(title)
     return fig, ax
+
+
+def _finish(fig: Any, **margins: float) -> Any:
+    from microg.plotting.common import finish
+
+    return finish(fig, **margins)
 
 
 def _pick(points: tuple[str, ...], point: str | None) -> int:
@@ -62,7 +68,7 @@ def plot_frf(frf: AccelerationFRF, *, point: str | None = None, title: str = "")
     ax.set_ylabel("|acceleration| per force [micro-g/N]")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
-    return fig
+    return _finish(fig)
 
 
 def plot_harmonic(resp: HarmonicResponse, *, point: str | None = None, title: str = "") -> Any:
@@ -76,7 +82,7 @@ def plot_harmonic(resp: HarmonicResponse, *, point: str | None = None, title: st
     ax.set_ylabel("amplitude [micro-g]")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
-    return fig
+    return _finish(fig)
 
 
 def plot_band_response(resp: BandResponse, *, point: str | None = None, title: str = "") -> Any:
@@ -90,7 +96,7 @@ def plot_band_response(resp: BandResponse, *, point: str | None = None, title: s
     ax.set_ylabel("band RMS [micro-g]")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
-    return fig
+    return _finish(fig)
 
 
 def plot_vibratory(va: VibratoryAssessment, *, point: str | None = None, title: str = "") -> Any:
@@ -116,7 +122,7 @@ def plot_vibratory(va: VibratoryAssessment, *, point: str | None = None, title: 
     ax.set_ylabel("band RMS [micro-g]")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
-    return fig
+    return _finish(fig)
 
 
 def plot_contributions(
@@ -146,7 +152,7 @@ def plot_contributions(
     ax.grid(True, axis="y", alpha=0.3)
     if r.sources:
         ax.legend(fontsize="small", ncol=2)
-    return fig
+    return _finish(fig, bottom=1.0)  # room for the slanted band labels
 
 
 def plot_allocation(alloc: Allocation, *, title: str = "") -> Any:
@@ -169,4 +175,4 @@ def plot_allocation(alloc: Allocation, *, title: str = "") -> Any:
     ax.set_ylabel("allowed force RMS per band [N]")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
-    return fig
+    return _finish(fig)

@@ -2,14 +2,24 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from collections.abc import Callable
+from functools import lru_cache, partial
+from typing import TYPE_CHECKING, Any
 
 from microg._io import to_jsonable
 
 if TYPE_CHECKING:
     from microg.analysis import Analysis
+    from microg.report.render import FigureJob, FigureRenderer
 
-__all__ = ["figure_names", "figures", "render_analysis"]
+__all__ = [
+    "PRELOAD",
+    "figure_jobs",
+    "figure_names",
+    "figures",
+    "render_analysis",
+    "start_renderer",
+]
 
 
 def figure_names(names: list[str]) -> dict[str, str]:
@@ -19,17 +29,26 @@ def figure_names(names: list[str]) -> dict[str, str]:
     return dict(safe_filenames(names))
 
 
-def figures(result: Analysis) -> dict[str, bytes]:
-    """PNG bytes of every figure of the report, keyed by file name."""
-    from microg.plotting.analysis import (
-        force_figure,
-        isolation_figure,
-        model_figure,
-        modes_figure,
-        observation_figure,
-    )
-    from microg.plotting.common import png_bytes
-    from microg.plotting.environment import plot_integrated_acceleration, plot_psd
+#: relative drawing costs of the figures (measured), to share them between processes
+_WEIGHTS = {
+    "model": 2.0,
+    "modes": 1.0,
+    "forces": 0.8,
+    "bands": 1.8,
+    "psd": 1.2,
+    "integrated": 1.0,
+    "isolated": 1.0,
+    "vibratory": 1.5,
+    "sources": 1.5,
+}
+
+
+def figure_jobs(result: Analysis) -> list[FigureJob]:
+    """Every figure of the report as a job (file name, cost, how to draw it), in order.
+
+    Nothing is drawn (nor matplotlib imported) until a job's ``draw`` is called.
+    """
+    from microg.report.render import FigureJob
 
     opts = result.options
     force_pts = {d.point: d.unit_direction for d in opts.disturbances}
@@ -37,57 +56,145 @@ def figures(result: Analysis) -> dict[str, bytes]:
         for s in opts.sources.sources:
             force_pts.setdefault(s.at, s.direction)
     observed = list(result.observations) or list(opts.observe)
-    out = {
-        "model.png": png_bytes(model_figure(result.structure, result.modes, force_pts, observed)),
-        "modes.png": png_bytes(modes_figure(result)),
-    }
+
+    def job(name: str, kind: str, build: Callable[[], Any]) -> FigureJob:
+        def draw() -> bytes:
+            from microg.plotting.common import png_bytes
+
+            return png_bytes(build())
+
+        return FigureJob(name, _WEIGHTS[kind], draw)
+
+    def model() -> Any:
+        from microg.plotting.analysis import model_figure
+
+        return model_figure(result.structure, result.modes, force_pts, observed)
+
+    def modes() -> Any:
+        from microg.plotting.analysis import modes_figure
+
+        return modes_figure(result)
+
+    def forces() -> Any:
+        from microg.plotting.analysis import force_figure
+
+        return force_figure(list(opts.disturbances), opts.duration_s)
+
+    jobs = [job("model.png", "model", model), job("modes.png", "modes", modes)]
     if opts.disturbances:
-        out["forces.png"] = png_bytes(force_figure(list(opts.disturbances), opts.duration_s))
+        jobs.append(job("forces.png", "forces", forces))
     stems = figure_names(list(result.observations))
     for name, ob in result.observations.items():
-        s = stems[name]
-        r = ob.response
-        from microg.plotting.analysis import live_axes
-
-        live = live_axes(r.acceleration)
-        axes = tuple("xyz"[i] for i in live) or ("x",)
-        rows = live or [0]
-        out[f"{s}-bands.png"] = png_bytes(observation_figure(ob))
-        spec = ob.assessment.spectrum
-        from microg.environment.metrics import Spectrum
-
-        out[f"{s}-psd.png"] = png_bytes(
-            plot_psd(
-                Spectrum(spec.freq_hz, spec.psd[rows], spec.df_hz, spec.nyquist_hz, spec.method),
-                axes=axes,
-                title=f"PSD at {name}",
-            )
-        )
-        out[f"{s}-integrated.png"] = png_bytes(
-            plot_integrated_acceleration(
-                r.timepts,
-                r.acceleration[rows],
-                axes=axes,
-                title=f"10-s integrated acceleration at {name}",
-            )
-        )
-        if ob.isolation.package_accel is not None:
-            out[f"{s}-isolated.png"] = png_bytes(isolation_figure(ob))
+        jobs += _observation_jobs(job, stems[name], name, ob)
     fd = result.frequency_domain
     if fd is not None:
         vstems = figure_names(list(fd.points))
         for name in fd.points:
             s = vstems[name]
-            out[f"{s}-vibratory.png"] = png_bytes(fd.plot(name, kind="bands"))
-            out[f"{s}-sources.png"] = png_bytes(fd.plot(name, kind="contributions"))
+            for kind, plot in (("vibratory", "bands"), ("sources", "contributions")):
+                jobs.append(job(f"{s}-{kind}.png", kind, partial(fd.plot, name, kind=plot)))
+    return jobs
+
+
+def _observation_jobs(job: Any, s: str, name: str, ob: Any) -> list[FigureJob]:
+    """The figures of one observed point: history and bands, PSD, integrals, isolation."""
+
+    def live() -> tuple[tuple[str, ...], list[int]]:
+        from microg.plotting.analysis import live_axes
+
+        rows = live_axes(ob.response.acceleration)
+        return tuple("xyz"[i] for i in rows) or ("x",), rows or [0]
+
+    def bands() -> Any:
+        from microg.plotting.analysis import observation_figure
+
+        return observation_figure(ob)
+
+    def psd() -> Any:
+        from microg.environment.metrics import Spectrum
+        from microg.plotting.environment import plot_psd
+
+        axes, rows = live()
+        spec = ob.assessment.spectrum
+        return plot_psd(
+            Spectrum(spec.freq_hz, spec.psd[rows], spec.df_hz, spec.nyquist_hz, spec.method),
+            axes=axes,
+            title=f"PSD at {name}",
+        )
+
+    def integrated() -> Any:
+        from microg.plotting.environment import plot_integrated_acceleration
+
+        axes, rows = live()
+        r = ob.response
+        return plot_integrated_acceleration(
+            r.timepts,
+            r.acceleration[rows],
+            axes=axes,
+            title=f"10-s integrated acceleration at {name}",
+        )
+
+    def isolated() -> Any:
+        from microg.plotting.analysis import isolation_figure
+
+        return isolation_figure(ob)
+
+    out = [
+        job(f"{s}-bands.png", "bands", bands),
+        job(f"{s}-psd.png", "psd", psd),
+        job(f"{s}-integrated.png", "integrated", integrated),
+    ]
+    if ob.isolation.package_accel is not None:
+        out.append(job(f"{s}-isolated.png", "isolated", isolated))
     return out
+
+
+def figures(result: Analysis, renderer: FigureRenderer | None = None) -> dict[str, bytes]:
+    """PNG bytes of every figure of the report, keyed by file name, in report order.
+
+    Parameters
+    ----------
+    result : Analysis
+    renderer : FigureRenderer, optional
+        Helper processes started before the computation (see :mod:`microg.report.render`):
+        they draw the figures while this process loads the HTML template.  Without one, or
+        if it fails, the figures are drawn here.  The bytes are the same either way.
+    """
+    if renderer is not None and renderer.active:
+        out = renderer.render(figure_jobs, result, while_waiting=_analysis_template)
+        if out is not None:
+            return out
+    return {j.name: j.draw() for j in figure_jobs(result)}
+
+
+#: what a renderer for :func:`figures` preloads
+PRELOAD = ("microg.plotting.analysis", "microg.plotting.environment", "microg.report.analysis")
+
+
+def start_renderer(processes: int | None = None) -> FigureRenderer:
+    """Start the helper processes of :func:`figures` now, before the computation.
+
+    They import matplotlib and the figure modules on another core while the caller
+    computes; pass the renderer to :func:`figures` (use it as a context manager, so the
+    helpers stop if the computation fails).  See :mod:`microg.report.render`.
+    """
+    from microg.report.render import FigureRenderer
+
+    return FigureRenderer.start(PRELOAD, processes)
+
+
+@lru_cache(maxsize=1)
+def _analysis_template() -> Any:
+    """The compiled ``analyze.html`` template (compiling it takes ~0.15 s: once a process)."""
+    from microg.report.html import environment
+
+    return environment().get_template("analyze.html")
 
 
 def render_analysis(result: Analysis, figs: dict[str, bytes]) -> str:
     """Self-contained HTML of the analysis, figures embedded as data URIs."""
     from microg import __version__
     from microg.plotting.common import png_data_uri
-    from microg.report.html import environment
 
     data = to_jsonable(result.to_dict())
     uris = {k: png_data_uri(v) for k, v in figs.items()}
@@ -124,10 +231,8 @@ def render_analysis(result: Analysis, figs: dict[str, bytes]) -> str:
                     "figs": [uris[f"{s}-{k}.png"] for k in ("vibratory", "sources")],
                 }
             )
-    return (
-        environment()
-        .get_template("analyze.html")
-        .render(
+    return str(
+        _analysis_template().render(
             version=__version__,
             d=data,
             obs=obs,

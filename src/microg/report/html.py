@@ -5,12 +5,15 @@ The report reads result objects only; it computes nothing.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from jinja2 import Environment, PackageLoader, StrictUndefined, select_autoescape
 
 from microg import __version__
 from microg._io import to_jsonable
-from microg.seed.nomenclature import NOMENCLATURE
-from microg.seed.reproduce import Reproduction
+
+if TYPE_CHECKING:  # the seed reproduction loads only for its own report (~0.1 s)
+    from microg.seed.reproduce import Reproduction
 
 __all__ = ["render_reproduction", "environment", "id_ranges"]
 
@@ -58,6 +61,9 @@ def render_reproduction(
     response_uri : str, optional
         PNG data URI of the response at the observation point.
     """
+    from microg.seed.ioc import printed_literals
+    from microg.seed.nomenclature import NOMENCLATURE
+
     data = to_jsonable(rep.contract())
     tmpl = environment().get_template("reproduce.html")
     return tmpl.render(
@@ -67,6 +73,7 @@ def render_reproduction(
         agreement=rep.agreement,
         comparisons=rep.comparisons,
         nomenclature=NOMENCLATURE,
+        lit=printed_literals(),
         opts=data["options"],
         table4=rep.table4,
         appendix=to_jsonable(rep.appendix_c),

@@ -1,0 +1,204 @@
+"""The lean figure machinery of microg.plotting.common (issue 8, "Speed of the main job").
+
+References: a brute-force slice-by-slice min/max for the drawing envelope; matplotlib's own
+LogFormatterSciNotation labels for the Unicode log labels; matplotlib's own minor ticks (the
+same figure drawn both ways) for the lean minor ticks; matplotlib's measured text extents for
+the fixed margins.
+"""
+
+from __future__ import annotations
+
+import io
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
+from matplotlib.figure import Figure
+from matplotlib.ticker import LogFormatterSciNotation
+from PIL import Image
+
+from microg.plotting.common import PlainLogFormatter, envelope, finish, new_figure
+
+
+def _brute_envelope_values(y: np.ndarray, bins: int) -> list[tuple[float, float]]:
+    """Min and max of each slice, as envelope() slices the record (a Python loop)."""
+    n = y.size
+    k = -(-n // bins)
+    return [(float(y[i : i + k].min()), float(y[i : i + k].max())) for i in range(0, n, k)]
+
+
+def test_envelope_keeps_every_slice_extreme_and_the_ends():
+    rng = np.random.default_rng(7)
+    n, bins = 20_001, 100
+    t = np.linspace(0.0, 200.0, n)
+    y = np.cumsum(rng.standard_normal(n))
+    y[12_345] = 80.0  # a spike: one sample
+    xe, ye = envelope(t, y, bins=bins)
+    assert xe.size <= 2 * bins + 4
+    assert np.all(np.diff(xe) > 0)  # time order, no duplicates
+    # every kept point is a sample of the record, at its own time
+    idx = np.searchsorted(t, xe)
+    assert np.array_equal(t[idx], xe) and np.array_equal(y[idx], ye)
+    assert xe[0] == t[0] and xe[-1] == t[-1]
+    assert ye.max() == 80.0 and ye.min() == y.min()  # the peak is drawn exactly
+    # reference: each slice's min and max, by brute force, are among the kept values
+    k = -(-n // bins)
+    for s, (lo, hi) in enumerate(_brute_envelope_values(y, bins)):
+        inside = ye[(idx >= s * k) & (idx < (s + 1) * k)]
+        assert inside.min() == lo and inside.max() == hi  # exact: the same samples
+
+
+def test_envelope_leaves_short_lines_alone():
+    t = np.arange(100.0)
+    y = np.sin(t)
+    xe, ye = envelope(t, y, bins=2000)
+    assert xe is t and ye is y
+
+
+@given(arrays(np.float64, st.integers(3, 3000), elements=st.floats(-1e6, 1e6)))
+def test_envelope_property_extremes_kept(y):
+    # invariant: the drawn range equals the record's range, and only samples are drawn
+    t = np.arange(y.size, dtype=float)
+    xe, ye = envelope(t, y, bins=7)
+    assert ye.max() == y.max() and ye.min() == y.min()
+    assert np.array_equal(y[xe.astype(int)], ye)
+
+
+@pytest.mark.parametrize(
+    ("value", "expected"),
+    [
+        (1e-5, "10\u207b\u2075"),
+        (1.0, "10\u2070"),
+        (1e3, "10\u00b3"),
+        (1e-12, "10\u207b\u00b9\u00b2"),
+    ],
+)
+def test_log_labels_are_matplotlibs_in_unicode(value, expected):
+    # reference: matplotlib's mathtext label for the same tick, $\mathdefault{10^{k}}$
+    fig = Figure()
+    ax = fig.add_subplot()
+    ax.loglog([1e-13, 1e4], [1.0, 2.0])
+    ours, theirs = PlainLogFormatter(), LogFormatterSciNotation()
+    for f in (ours, theirs):
+        f.set_axis(ax.xaxis)
+        f.set_locs([value])
+    exponent = round(np.log10(value))
+    assert theirs(value) == rf"$\mathdefault{{10^{{{exponent}}}}}$"
+    assert ours(value) == expected
+
+
+def test_log_labels_non_decade():
+    # reference: matplotlib's mathtext labels on a narrow log axis (labelled between decades)
+    fig = Figure()
+    ax = fig.add_subplot()
+    ax.loglog([1.0, 5.0], [1.0, 2.0])
+    values = [2.0, 3.0, 30.0, 0.02]
+    ours, theirs = (
+        PlainLogFormatter(labelOnlyBase=False),
+        LogFormatterSciNotation(labelOnlyBase=False),
+    )
+    for f in (ours, theirs):
+        f.set_axis(ax.xaxis)
+        f.set_locs(values)
+    assert [theirs(v) for v in values] == [
+        r"$\mathdefault{2\times10^{0}}$",
+        r"$\mathdefault{3\times10^{0}}$",
+        r"$\mathdefault{3\times10^{1}}$",
+        r"$\mathdefault{2\times10^{-2}}$",
+    ]
+    assert [ours(v) for v in values] == [
+        "2\u00d710\u2070",
+        "3\u00d710\u2070",
+        "3\u00d710\u00b9",
+        "2\u00d710\u207b\u00b2",
+    ]
+
+
+def _pixels(fig: Figure) -> np.ndarray:
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=80)
+    return np.asarray(Image.open(io.BytesIO(buf.getvalue())).convert("RGB"), int)
+
+
+def _loglog_figure() -> Figure:
+    fig = new_figure(6.0, 4.0)
+    ax = fig.add_subplot()
+    f = np.logspace(-2, 2.5, 200)
+    ax.loglog(f, 1e-3 / (1 + f**2), lw=0.8, label="x")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend()
+    return fig
+
+
+def test_lean_minor_ticks_draw_as_matplotlibs():
+    # reference: the same figure with matplotlib's Tick objects for the minor ticks and grid
+    lean = finish(_loglog_figure())
+    plain = _loglog_figure()  # the same labels and margins, matplotlib's own minor ticks
+    for axis in plain.axes[0].xaxis, plain.axes[0].yaxis:
+        axis.set_major_formatter(PlainLogFormatter())
+        axis.set_minor_formatter(PlainLogFormatter(labelOnlyBase=False))
+    p = lean.subplotpars
+    plain.subplots_adjust(left=p.left, right=p.right, bottom=p.bottom, top=p.top)
+    assert len(lean.axes[0].xaxis.get_minorticklocs()) == 0  # ours: no minor Tick objects
+    assert len(plain.axes[0].xaxis.get_minorticklocs()) > 10
+    ours, theirs = _pixels(lean), _pixels(plain)
+    assert ours.shape == theirs.shape
+    diff = np.abs(ours - theirs).max(axis=2)
+    # anti-aliasing of a line drawn by a collection rather than one Line2D per tick may
+    # differ by a grey level or two; no pixel may differ visibly
+    assert diff.max() <= 8, diff.max()
+    assert np.count_nonzero(diff) <= 1e-3 * diff.size
+
+
+def test_report_figures_keep_every_label_inside():
+    # reference: matplotlib's own text extents, measured after drawing
+    import microg
+    from microg.report.analysis import figure_jobs
+
+    result = microg.analyze("ioc", observe=["lab"], duration=40, dt=0.02, isolation=False)
+    jobs = figure_jobs(result)
+    assert [j.name for j in jobs] == [
+        "model.png",
+        "modes.png",
+        "forces.png",
+        "lab-bands.png",
+        "lab-psd.png",
+        "lab-integrated.png",
+    ]
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    from microg.plotting.analysis import (
+        force_figure,
+        model_figure,
+        modes_figure,
+        observation_figure,
+    )
+    from microg.plotting.environment import plot_integrated_acceleration, plot_psd
+
+    ob = result.observations["lab"]
+    r = ob.response
+    forces = {d.point: d.unit_direction for d in result.options.disturbances}
+    figs = [
+        model_figure(result.structure, result.modes, forces, ["lab"]),
+        modes_figure(result),
+        force_figure(list(result.options.disturbances), result.options.duration_s),
+        observation_figure(ob),
+        plot_psd(ob.assessment.spectrum),
+        plot_integrated_acceleration(r.timepts, r.acceleration),
+    ]
+    for fig in figs:
+        canvas = FigureCanvasAgg(fig)
+        canvas.draw()
+        renderer = canvas.get_renderer()
+        box = fig.bbox
+        for ax in fig.axes:
+            # the drawn tick labels, axis labels, title and legend of each axes
+            e = ax.get_tightbbox(renderer)
+            assert e.x0 >= box.x0 - 1 and e.x1 <= box.x1 + 1, (ax.get_title(), e, box)
+            assert e.y0 >= box.y0 - 1 and e.y1 <= box.y1 + 1, (ax.get_title(), e, box)
+        # and the axes of a two-row figure do not overlap each other's labels
+        if len(fig.axes) == 2:
+            top, bottom = (a.get_tightbbox(renderer) for a in fig.axes)
+            assert bottom.y1 <= top.y0 + 1

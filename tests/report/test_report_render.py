@@ -1,0 +1,114 @@
+"""Figures drawn by forked helper processes (microg.report.render) equal those drawn in-process.
+
+References: the in-process drawing (:func:`microg.report.analysis.figures` without a renderer)
+byte for byte; Graham's list-scheduling bound for the sharing of the figures.  The fork tests
+run in a fresh interpreter (a pytest process may run other threads, where the renderer
+rightly refuses to fork).
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from microg.report.render import FigureRenderer, default_processes, split_jobs
+
+SCRIPT = r"""
+import json, os, sys
+import microg
+import microg.report.analysis as rep
+from microg.report.render import FigureJob, FigureRenderer
+
+out = {}
+with rep.start_renderer(processes=2) as renderer:  # started before the computation
+    out["active"] = renderer.active
+    result = microg.analyze("ioc", observe=["lab"], duration=40, dt=0.02)
+    forked = rep.figures(result, renderer)
+    out["error"] = renderer.error
+out["parent_loaded_matplotlib"] = "matplotlib" in sys.modules
+here = rep.figures(result)
+out["names"] = [list(forked), list(here)]
+out["same_bytes"] = all(forked[k] == here[k] for k in here)
+out["png"] = all(v[:8] == b"\x89PNG\r\n\x1a\n" for v in forked.values())
+
+
+def failing(payload):
+    raise RuntimeError("no figures today")
+
+
+def one(payload):
+    return [FigureJob("a.png", 1.0, lambda: b"a"), FigureJob("b.png", 1.0, lambda: b"b")]
+
+
+r = FigureRenderer.start((), processes=2)
+out["failing"] = [r.render(failing, 1), "no figures today" in (r.error or "")]
+r = FigureRenderer.start((), processes=2)
+out["unpicklable"] = [r.render(one, lambda: 0), r.error is not None]
+r = FigureRenderer.start((), processes=2)
+os.kill(r._pid, 9)
+out["killed"] = [r.render(one, 1), r.error is not None]
+r = FigureRenderer.start((), processes=2)
+out["tiny"] = r.render(one, 1)
+r = FigureRenderer.start((), processes=2)
+r.close()  # started and never used: the helper stops
+out["closed"] = r.active
+try:
+    os.waitpid(-1, os.WNOHANG)
+    out["children_left"] = True
+except ChildProcessError:
+    out["children_left"] = False
+print(json.dumps({k: (v if not isinstance(v, dict) else sorted(v)) for k, v in out.items()},
+                 default=lambda b: b.decode()))
+"""
+
+
+@pytest.fixture(scope="module")
+def forked() -> dict:
+    proc = subprocess.run(
+        [sys.executable, "-c", SCRIPT], capture_output=True, text=True, check=True, timeout=300
+    )
+    return json.loads(proc.stdout.strip().splitlines()[-1])
+
+
+def test_helpers_draw_the_same_figures_as_the_caller(forked):
+    assert forked["active"] and forked["error"] is None
+    assert forked["names"][0] == forked["names"][1]  # same files, same (report) order
+    assert forked["same_bytes"] and forked["png"]  # reference: in-process drawing, bytewise
+    assert not forked["parent_loaded_matplotlib"]  # the caller never imported matplotlib
+
+
+def test_a_failing_helper_means_drawing_in_process(forked):
+    assert forked["failing"] == [None, True]  # None: the caller draws; the error is kept
+    assert forked["unpicklable"] == [None, True]
+    assert forked["killed"] == [None, True]
+
+
+def test_helpers_share_the_jobs_and_stop(forked):
+    assert forked["tiny"] == ["a.png", "b.png"]  # two jobs, one in each process, in order
+    assert forked["closed"] is False
+    assert forked["children_left"] is False  # every helper reaped
+
+
+def test_one_process_starts_no_helper(monkeypatch):
+    monkeypatch.setenv("MICROG_FIGURE_PROCESSES", "1")
+    assert default_processes() == 1
+    r = FigureRenderer.start(())
+    assert not r.active and r.render(lambda p: [], None) is None
+    monkeypatch.setenv("MICROG_FIGURE_PROCESSES", "not a number")
+    assert default_processes() == 1
+
+
+@given(st.lists(st.floats(0.01, 10.0), min_size=1, max_size=30), st.integers(1, 4))
+def test_split_jobs_is_a_balanced_partition(weights, parts):
+    groups = split_jobs(weights, parts)
+    flat = sorted(i for g in groups for i in g)
+    assert flat == list(range(len(weights)))  # every job exactly once
+    assert len(groups) <= parts and all(g == sorted(g) for g in groups)
+    # Graham's bound for list scheduling: no group exceeds the mean load by more than one job
+    loads = [sum(weights[i] for i in g) for g in groups]
+    assert max(loads) <= sum(weights) / parts + max(weights) + 1e-9
