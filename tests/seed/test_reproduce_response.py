@@ -58,3 +58,37 @@ def test_table4_uses_eq_3_1(c1) -> None:
         c1.phi, c1.modal_mass * SLUG, np.sqrt(c1.omega2), psi, psi, crew, np.array([0.0])
     )
     assert np.allclose(rr.peak_accel_modes / 9.80665, [b[0].accel_g, b[1].accel_g], rtol=1e-12)
+
+
+@pytest.mark.parametrize(("z_e", "z_a", "where"), [(10.0, -55.0, "z_e"), (-55.0, -130.0, "z_a")])
+def test_points_off_the_main_body_are_refused(z_e: float, z_a: float, where: str) -> None:
+    # Eq. 3.1 uses psi = [1, z/l_k, 0, 0], true on the rigid main body only (-126.66..0 ft):
+    # a point on the keel (z > 0) or below the orbiter is refused, naming the parameter
+    from microg.errors import InputError
+    from microg.seed.reproduce import ReproduceOptions
+
+    with pytest.raises(InputError) as exc:
+        ReproduceOptions(CrewPushoff(25 * LBF), z_e * FT, z_a * FT)
+    assert exc.value.where == where and "main body" in str(exc.value)
+    ReproduceOptions(CrewPushoff(25 * LBF), 0.0, -126.66 * FT)  # the ends are accepted
+
+
+def test_main_body_range_is_the_models() -> None:
+    # the range's ends are the main body of the shipped model: its lowest mass (the orbiter)
+    # and the keel joint, where the keel begins
+    from microg.models.toml import load_station
+    from microg.seed.eq31 import MAIN_BODY_Z_RANGE_FT
+
+    st = load_station("ioc")
+    main = next(b for b in st.bodies if b.name == "main")
+    zs = [m.position[2] / FT for m in main.masses]
+    assert min(zs) == pytest.approx(MAIN_BODY_Z_RANGE_FT[0], abs=1e-9)
+    assert max(zs) <= MAIN_BODY_Z_RANGE_FT[1]
+
+
+def test_unknown_case_is_refused() -> None:
+    from microg.errors import InputError
+
+    with pytest.raises(InputError) as exc:
+        reproduce(cases=["xy_orbiter"])
+    assert exc.value.where == "cases"
