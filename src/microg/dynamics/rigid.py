@@ -66,8 +66,11 @@ def rigid_basis(
         rest = rest - accepted @ np.linalg.lstsq(ma, accepted.T @ mcc @ rest, rcond=None)[0]
     if rest.shape[1]:
         mr = rest.T @ mcc @ rest
+        dr = np.diag(mr).copy()
+        rest = rest[:, dr > 0] / np.sqrt(dr[dr > 0])[None, :]  # unit M-norm (units mixed)
+        mr = rest.T @ mcc @ rest
         w, v = np.linalg.eigh(0.5 * (mr + mr.T))
-        keep = w > 1e-12 * max(w.max(), 1e-300)
+        keep = w > 1e-12 * max(w.max(), 1e-300) if w.size else np.zeros(0, bool)
         g = rest @ (v[:, keep] / np.sqrt(w[keep]))
         kr = g.T @ kcc @ g
         _, v = np.linalg.eigh(0.5 * (kr + kr.T))
@@ -84,16 +87,26 @@ def _m_orthonormal_coefficients(gram: np.ndarray, coef: np.ndarray) -> np.ndarra
 
     Keeping the order keeps the rigid modes named (x, y, z translations, then rotations about
     the centre of mass, each orthogonalised against the earlier ones); a dependent or
-    massless direction falls back to the eigen-decomposition, dropping it.
+    massless direction falls back to the eigen-decomposition, dropping it.  The Gram matrix
+    is first scaled to a unit diagonal: its entries mix units (kg for translations, kg m^2
+    for rotations), so that a station's rotary inertia 2e17 kg m^2 beside its mass 3.6e4 kg
+    (fuzz reproduction ``model-5a35beda18``) must not make the translations "dependent".
     """
     g = 0.5 * (gram + gram.T)
-    w = np.linalg.eigvalsh(g) if g.size else np.zeros(0)
+    dg = np.diag(g).copy() if g.size else np.zeros(0)
+    live = dg > 0.0
+    if not np.all(live):
+        # a candidate without mass: no mass-normalised direction of it exists
+        return _m_orthonormal_coefficients(g[np.ix_(live, live)], coef[:, live])
+    sc = 1.0 / np.sqrt(dg)
+    gs = sc[:, None] * g * sc[None, :]
+    w = np.linalg.eigvalsh(gs) if gs.size else np.zeros(0)
     if w.size and w.min() > 1e-10 * w.max():
-        r = sla.cholesky(g, lower=False)
-        return coef @ sla.solve_triangular(r, np.eye(g.shape[0]))
-    w, v = np.linalg.eigh(g)
+        r = sla.cholesky(gs, lower=False)
+        return (coef * sc[None, :]) @ sla.solve_triangular(r, np.eye(g.shape[0]))
+    w, v = np.linalg.eigh(gs)
     keep = w > 1e-12 * max(w.max(), 1e-300)
-    return coef @ (v[:, keep] / np.sqrt(w[keep]))
+    return (coef * sc[None, :]) @ (v[:, keep] / np.sqrt(w[keep]))
 
 
 def rowwise_small(kx: np.ndarray, ax: np.ndarray, tol: float) -> np.ndarray:

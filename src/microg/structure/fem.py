@@ -1,10 +1,15 @@
-"""Three-dimensional frame finite elements of a free-free station.
+"""Three-dimensional frame finite elements of a free-free tree-of-beams station.
 
-Each beam is cut into 12-DOF Euler-Bernoulli frame elements (3 translations and 3 small
-rotations per node) with consistent mass; each rigid body is one 6-DOF master node.  The
-assembled :class:`~microg.structure.Structure` has sparse (CSR) mass and stiffness matrices
-and is always free-free: no degree of freedom is constrained.  (Validation against clamped
-textbook beams deletes DOFs afterwards with :func:`constrain`.)
+The tree station is a convenience that generates a frame graph: :func:`build_fem` meshes it
+with :func:`microg.structure.frame.graph_from_station` (the one mesher) and assembles that
+graph with :func:`microg.structure.frame.assemble_frame` (the one assembler and the element
+kernels), then keeps what only a tree has: its exact flexibility (:class:`FrameTree`), used
+by the modal solvers.  Each beam is cut into 12-DOF Euler-Bernoulli frame elements (3
+translations and 3 small rotations per node) with consistent mass; each rigid body is one
+6-DOF master node.  The :class:`FrameStructure` has sparse (CSR) mass and stiffness
+matrices and is always free-free: no degree of freedom is constrained.  (Validation against
+clamped textbook beams deletes DOFs afterwards with :func:`constrain`.)  Massless
+coordinates are kept (the solvers condense them exactly).
 
 Modelling assumptions, each a documented choice:
 
@@ -50,6 +55,13 @@ Modelling assumptions, each a documented choice:
 * **Rigid-body vectors** (:attr:`Structure.rigid_body`) are exact unit translations and unit
   rotations **about the station's centre of mass** (not the origin), so that they, and the
   rigid modes, do not depend on where the model sits in its frame.
+* **Rotary inertia.**  A station whose rigid rotations about its centre of mass have an
+  inertia tensor with a principal moment at most :data:`INERTIA_ZERO_FRACTION` of its
+  trace (zero to rounding: point masses on one line with no rotary inertia, a single point
+  mass) is refused, naming the components: that rotation has neither inertia nor
+  stiffness, a mechanism (:func:`check_rotary_inertia`).
+* **Size.**  Meshes beyond :data:`~microg.structure.frame.MAX_FEM_DOF` degrees of freedom
+  are refused before any node is made.
 * **Exact flexibility** (:class:`FrameTree`).  The model is a tree: every node but the root
   body's master is the far end of exactly one element.  With ``d_e = x_b - x_a`` the
   element's deformation is ``delta_e = q_b - T(d_e) q_a`` (``T`` the rigid link) and
@@ -65,15 +77,33 @@ Modelling assumptions, each a documented choice:
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
 
 from microg.errors import InputError
-from microg.models.station import POLAR_GYRATION_FRACTION, Beam, PointMass, RigidBody, Station
+from microg.models.graph import ConcentratedMass
+from microg.models.station import POLAR_GYRATION_FRACTION, Station
+from microg.structure.frame import (
+    AXIAL_PENALTY,
+    DEFAULT_ELEMENTS_PER_BEAM,
+    DOF_NAMES,
+    GJ_ZERO_FRACTION,
+    MAX_FEM_DOF,
+    TORSION_PENALTY,
+    _mass_properties,
+    _skew,
+    assemble_frame,
+    frame_mass_local,
+    frame_rotation,
+    frame_stiffness_local,
+    graph_from_station,
+    point_mass_matrix,
+    rigid_link,
+    torsion_is_rigid,
+)
 from microg.structure.structure import PointMap, Structure
 
 __all__ = [
@@ -89,171 +119,31 @@ __all__ = [
     "rigid_link",
     "torsion_is_rigid",
     "cantilever_flexibility_local",
+    "check_rotary_inertia",
+    "DEFAULT_ELEMENTS_PER_BEAM",
     "DOF_NAMES",
     "AXIAL_PENALTY",
     "TORSION_PENALTY",
     "GJ_ZERO_FRACTION",
+    "INERTIA_ZERO_FRACTION",
+    "MAX_FEM_DOF",
     "MAX_STIFFNESS_RATIO",
     "check_stiffness_contrast",
     "POLAR_GYRATION_FRACTION",
 ]
 
-#: coordinate names of a node, in order
-DOF_NAMES = ("ux", "uy", "uz", "rx", "ry", "rz")
-#: axially rigid beams: EA = AXIAL_PENALTY * max(EI_y, EI_z) / L^2
-AXIAL_PENALTY = 1e6
-#: torsionally rigid beams (gj = 0): GJ = TORSION_PENALTY * max(EI_y, EI_z)
-TORSION_PENALTY = 1e4
-#: a torsional stiffness at most this fraction of max(EI_y, EI_z) is numerically zero and is
-#: treated as gj = 0 (the rule of docs/model-format.md: 1e-30 lbf*ft^2 behaves like 0)
-GJ_ZERO_FRACTION = 1e-12
 #: largest accepted ratio of the bending stiffnesses (EI) of two beams of one model.  Real
 #: stations span a few decades (a truss 1e10 N m^2, a light antenna 1e3 N m^2); in double
 #: precision a soft part 1e-12 of the stiff one keeps only ~4 digits in the rows where they
 #: join, and beyond 1e16 it is lost entirely (documented in docs/model-format.md)
 MAX_STIFFNESS_RATIO = 1e12
-#: default number of elements per beam when neither discretisation option is given
-DEFAULT_ELEMENTS_PER_BEAM = 10
+#: a principal moment of the station's inertia about its centre of mass at most this
+#: fraction of the tensor's trace is zero to rounding (the products r^T M r round at
+#: ~eps of the trace; 1e-13 is ~450 eps): the rotation about that axis has no inertia
+INERTIA_ZERO_FRACTION = 1e-13
 
 
-# --------------------------------------------------------------------------- kernels
-
-
-def frame_stiffness_local(
-    length: np.ndarray, ea: np.ndarray, ei_y: np.ndarray, ei_z: np.ndarray, gj: np.ndarray
-) -> np.ndarray:
-    """Stiffness matrices of 3-D Euler-Bernoulli frame elements in local axes.
-
-    Local DOF order per node ``(u, v, w, theta_x, theta_y, theta_z)``, node a then node b;
-    ``theta_z = dv/dx`` and ``theta_y = -dw/dx`` (Przemieniecki, *Theory of Matrix
-    Structural Analysis*, Eq. 5.115).
-
-    Parameters
-    ----------
-    length : ndarray (ne,)
-        Element lengths, m.
-    ea : ndarray (ne,)
-        Axial stiffness, N.
-    ei_y, ei_z : ndarray (ne,)
-        Bending stiffness about local y (deflection w) and local z (deflection v), N m^2.
-    gj : ndarray (ne,)
-        Torsional stiffness, N m^2.
-
-    Returns
-    -------
-    ndarray (ne, 12, 12)
-        N/m, N, N m per unit DOF.
-    """
-    L = np.asarray(length, float)
-    k = np.zeros((L.size, 12, 12))
-    _put2(k, (0, 6), np.asarray(ea, float) / L)
-    _put2(k, (3, 9), np.asarray(gj, float) / L)
-    _put4(k, (1, 5, 7, 11), np.asarray(ei_z, float) / L**3, _bend_k(L, +1.0))
-    _put4(k, (2, 4, 8, 10), np.asarray(ei_y, float) / L**3, _bend_k(L, -1.0))
-    return k
-
-
-def frame_mass_local(
-    length: np.ndarray, mass_per_length: np.ndarray, polar_mass_per_length: np.ndarray
-) -> np.ndarray:
-    """Consistent mass matrices of 3-D frame elements in local axes.
-
-    Translational mass from the same cubic (bending) and linear (axial) shape functions as
-    :func:`frame_stiffness_local`; torsional mass ``rho J L / 6 [[2, 1], [1, 2]]``.
-
-    Parameters
-    ----------
-    length : ndarray (ne,)
-        Element lengths, m.
-    mass_per_length : ndarray (ne,)
-        ``rho A``, kg/m.
-    polar_mass_per_length : ndarray (ne,)
-        ``rho J``, polar mass moment per length about the axis, kg m.
-
-    Returns
-    -------
-    ndarray (ne, 12, 12)
-        kg, kg m, kg m^2 per unit DOF.
-    """
-    L = np.asarray(length, float)
-    m = np.zeros((L.size, 12, 12))
-    mL = np.asarray(mass_per_length, float) * L
-    _put2(m, (0, 6), mL / 6.0, mass=True)
-    _put2(m, (3, 9), np.asarray(polar_mass_per_length, float) * L / 6.0, mass=True)
-    _put4(m, (1, 5, 7, 11), mL / 420.0, _bend_m(L, +1.0))
-    _put4(m, (2, 4, 8, 10), mL / 420.0, _bend_m(L, -1.0))
-    return m
-
-
-def frame_rotation(direction: np.ndarray, orientation: np.ndarray) -> np.ndarray:
-    """Rotation matrices from station to element axes (rows: local x, y, z).
-
-    Parameters
-    ----------
-    direction : ndarray (ne, 3)
-        Unit vectors along the elements (local x).
-    orientation : ndarray (ne, 3)
-        Local y axes (made exactly perpendicular to ``direction`` here).
-
-    Returns
-    -------
-    ndarray (ne, 3, 3)
-        ``R`` with ``v_local = R @ v_station``.
-    """
-    ex = np.asarray(direction, float)
-    ex = ex / np.linalg.norm(ex, axis=-1, keepdims=True)
-    ey = np.asarray(orientation, float)
-    ey = ey - np.sum(ey * ex, axis=-1, keepdims=True) * ex
-    ey = ey / np.linalg.norm(ey, axis=-1, keepdims=True)
-    ez = np.cross(ex, ey)
-    return np.stack([ex, ey, ez], axis=-2)
-
-
-def rigid_link(offset: np.ndarray) -> np.ndarray:
-    """Rigid-link matrices: slave-node DOFs from master-node DOFs.
-
-    ``u_s = u_m + theta_m x d`` and ``theta_s = theta_m`` with ``d = x_s - x_m``.
-
-    Parameters
-    ----------
-    offset : ndarray (..., 3)
-        Slave position minus master position, m.
-
-    Returns
-    -------
-    ndarray (..., 6, 6)
-    """
-    d = np.asarray(offset, float)
-    t = np.zeros((*d.shape[:-1], 6, 6))
-    t[..., range(6), range(6)] = 1.0
-    t[..., :3, 3:] = -_skew(d)
-    return t
-
-
-def point_mass_matrix(mass: np.ndarray, inertia: np.ndarray, offset: np.ndarray) -> np.ndarray:
-    """6x6 mass matrices of point masses rigidly attached to a node.
-
-    Parameters
-    ----------
-    mass : ndarray (p,)
-        kg.
-    inertia : ndarray (p, 3, 3)
-        Rotary inertia about each mass's own centre, station axes, kg m^2.
-    offset : ndarray (p, 3)
-        Mass centre minus node position, m.
-
-    Returns
-    -------
-    ndarray (p, 6, 6)
-        ``T^T diag(m I, J) T`` with ``T`` the rigid link (mass, m [d]x coupling and the
-        parallel-axis inertia ``J + m (|d|^2 I - d d^T)``).
-    """
-    m = np.asarray(mass, float)
-    local = np.zeros((m.size, 6, 6))
-    local[:, range(3), range(3)] = m[:, None]
-    local[:, 3:, 3:] = np.asarray(inertia, float)
-    t = rigid_link(offset)
-    return np.swapaxes(t, -1, -2) @ local @ t
+# --------------------------------------------------------------------------- constraints
 
 
 def constrain(
@@ -521,89 +411,6 @@ class NodeSamples:
 # --------------------------------------------------------------------------- assembly
 
 
-@dataclass
-class _Mesh:
-    """Working state of the mesher (private)."""
-
-    positions: list[np.ndarray] = field(default_factory=list)
-    names: list[str] = field(default_factory=list)
-    body_node: dict[str, int] = field(default_factory=dict)
-    beam_s: dict[str, np.ndarray] = field(default_factory=dict)
-    beam_ref: dict[str, np.ndarray] = field(default_factory=dict)
-    beam_off: dict[str, np.ndarray] = field(default_factory=dict)
-
-    def add(self, position: np.ndarray, name: str) -> int:
-        self.positions.append(np.asarray(position, float))
-        self.names.append(name)
-        return len(self.positions) - 1
-
-    def locate(
-        self, station: Station, component: str, position: np.ndarray
-    ) -> tuple[int, np.ndarray]:
-        """Independent node carrying ``position`` on ``component``, and the offset to it."""
-        position = np.asarray(position, float)
-        if component in self.body_node:
-            node = self.body_node[component]
-        elif component in self.beam_s:
-            beam = station.component(component)
-            assert isinstance(beam, Beam)  # beam_s holds only beams
-            k = int(np.argmin(np.abs(self.beam_s[component] - beam.arc_length(position))))
-            node = int(self.beam_ref[component][k])
-        else:
-            raise InputError(
-                f"component {component!r} is not meshed (not in tree order)",
-                fix="list every beam after its parent and every body after its carrier beam",
-            )
-        return node, position - self.positions[node]
-
-
-def _beam_stations(beam: Beam, station: Station, h: float) -> np.ndarray:
-    """Arc lengths of the nodes of ``beam``: breakpoints kept, segments split evenly."""
-    L = beam.length
-    cuts = [0.0, L]
-    cuts += [beam.arc_length(pm.position) for pm in beam.masses]
-    cuts += [beam.arc_length(p.position) for p in station.points if p.on == beam.name]
-    cuts += [beam.arc_length(b.root) for b in station.beams if b.parent == beam.name]
-    cuts += [
-        beam.arc_length(b.attach)
-        for b in station.bodies
-        if b.parent == beam.name and b.attach is not None
-    ]
-    cuts_arr = np.unique(np.clip(np.asarray(cuts, float), 0.0, L))
-    keep = np.concatenate([[True], np.diff(cuts_arr) > 1e-9 * L])
-    cuts_arr = cuts_arr[keep]
-    cuts_arr[-1] = L
-    out = [np.zeros(1)]
-    for a, b in zip(cuts_arr[:-1], cuts_arr[1:], strict=True):
-        n = max(1, math.ceil((b - a) / h - 1e-9))
-        out.append(np.linspace(a, b, n + 1)[1:])
-    return np.concatenate(out)
-
-
-def _body_reference(body: RigidBody, station: Station) -> np.ndarray:
-    for bm in station.beams:
-        if bm.parent == body.name:
-            return np.asarray(bm.root, float)
-    if body.masses:
-        m = np.array([pm.mass for pm in body.masses])
-        p = np.array([pm.position for pm in body.masses], float)
-        return m @ p / m.sum()
-    return np.zeros(3)
-
-
-def torsion_is_rigid(beam: Beam) -> bool:
-    """True when ``beam``'s torsional stiffness is zero or numerically zero.
-
-    The rule (docs/model-format.md): ``gj <= GJ_ZERO_FRACTION max(EI_y, EI_z)`` is treated
-    exactly like ``gj = 0``, i.e. torsionally rigid.
-
-    Parameters
-    ----------
-    beam : Beam
-    """
-    return not beam.gj > GJ_ZERO_FRACTION * max(beam.ei_y, beam.ei_z)
-
-
 def check_stiffness_contrast(station: Station) -> None:
     """Refuse bending stiffnesses more than :data:`MAX_STIFFNESS_RATIO` apart.
 
@@ -632,12 +439,57 @@ def check_stiffness_contrast(station: Station) -> None:
         )
 
 
-def _effective_properties(beam: Beam) -> tuple[float, float, float]:
-    """Axial stiffness (N), torsional stiffness (N m^2) and rho J (kg m) used for ``beam``."""
-    ei_max = max(beam.ei_y, beam.ei_z)
-    ea = beam.ea if beam.ea is not None else AXIAL_PENALTY * ei_max / beam.length**2
-    gj = TORSION_PENALTY * ei_max if torsion_is_rigid(beam) else beam.gj
-    return float(ea), float(gj), beam.polar_mass_per_length
+def check_rotary_inertia(
+    mass: sp.spmatrix, rigid_body: dict[str, np.ndarray], carriers: Sequence[str]
+) -> None:
+    """Refuse a model whose rigid rotation about some axis has no inertia (a mechanism).
+
+    The inertia tensor the solver sees is ``J = R^T M R`` with ``R`` the unit rotations
+    about the centre of mass.  A principal moment at most :data:`INERTIA_ZERO_FRACTION` of
+    ``trace(J)`` is zero to rounding: the masses lie on one line (or at one point) and carry
+    no rotary inertia about it, so that rotation has neither inertia nor stiffness.
+
+    Parameters
+    ----------
+    mass : sparse (n, n)
+        Mass matrix, SI.
+    rigid_body : mapping
+        The exact rigid vectors (``"rx"``, ``"ry"``, ``"rz"`` about the centre of mass).
+    carriers : sequence of str
+        The components carrying mass (``"body core"``, ``"beam keel"``), for the message.
+
+    Raises
+    ------
+    InputError
+        Naming the components and the axis.
+    """
+    rot = np.column_stack([rigid_body[d] for d in ("rx", "ry", "rz")])
+    j = np.asarray(rot.T @ (mass @ rot))
+    w, v = np.linalg.eigh(0.5 * (j + j.T))
+    tr = float(np.trace(j))
+    zero = w <= INERTIA_ZERO_FRACTION * tr if tr > 0 else np.ones(3, bool)
+    if not zero.any():
+        return
+    where = ", ".join(carriers[:4]) + (
+        f" and {len(carriers) - 4} more" if len(carriers) > 4 else ""
+    )
+    if zero.all():
+        what = (
+            "all its mass is at one point and carries no rotary inertia: its three rotations "
+            "have neither inertia nor stiffness (a mechanism)"
+        )
+        fix = "give the point mass its rotary inertia (inertia = {xx = ..., yy = ..., zz = ...})"
+    else:
+        axis = v[:, int(np.argmin(w))]
+        axis = axis * np.sign(axis[np.argmax(np.abs(axis))])
+        what = (
+            "its masses lie on one line (through the centre of mass, along "
+            f"[{axis[0]:.3g}, {axis[1]:.3g}, {axis[2]:.3g}]) and carry no rotary inertia about "
+            "it: the rotation about that line has neither inertia nor stiffness (a mechanism)"
+        )
+        fix = "give the point masses their rotary inertia, or add a mass off that line"
+    lead = "" if len(carriers) == 1 else "the station: "
+    raise InputError(lead + what, where=where or None, fix=fix)
 
 
 def build_fem(
@@ -646,8 +498,12 @@ def build_fem(
     elements_per_beam: int | None = None,
     max_element_length: float | None = None,
     gravity_gradient: bool = False,
-) -> Structure:
+) -> FrameStructure:
     """Assemble the free-free frame finite-element model of ``station``.
+
+    The station is meshed into a graph (:func:`microg.structure.frame.graph_from_station`)
+    and assembled by :func:`microg.structure.frame.assemble_frame`; the tree of the mesh
+    gives the exact flexibility (:class:`FrameTree`).
 
     Parameters
     ----------
@@ -662,9 +518,17 @@ def build_fem(
 
     Returns
     -------
-    Structure
+    FrameStructure
         Sparse CSR mass and stiffness (method ``"fem"``, plane None), a :class:`PointMap`
-        per named point, exact rigid-body vectors, and :class:`NodeSamples` as ``samples``.
+        per named point, exact rigid-body vectors, :class:`NodeSamples` as ``samples`` and
+        the tree.
+
+    Raises
+    ------
+    InputError
+        Bad options, a mesh beyond :data:`MAX_FEM_DOF`, a body attached to nothing, a
+        stiffness contrast beyond :data:`MAX_STIFFNESS_RATIO`, or a rotation without
+        inertia (:func:`check_rotary_inertia`), each naming the parameter or component.
     """
     if elements_per_beam is not None and (
         int(elements_per_beam) != elements_per_beam or elements_per_beam < 1
@@ -691,130 +555,18 @@ def build_fem(
                 fix="give it a parent beam and an attach point",
             )
 
-    mesh = _Mesh()
-    for body in station.bodies:
-        if body.parent is None:
-            mesh.body_node[body.name] = mesh.add(_body_reference(body, station), body.name)
-
-    el: dict[str, list[np.ndarray]] = {k: [] for k in ("a", "b", "da", "db", "len", "dir", "ori")}
-    props: list[np.ndarray] = []
-    for beam in station.beams:
-        if beam.parent in mesh.body_node:
-            parent_node = mesh.body_node[beam.parent]
-        elif beam.parent in mesh.beam_s:
-            parent_node, _ = mesh.locate(station, beam.parent, beam.root)
-        else:
-            raise InputError(
-                f"beam {beam.name!r}: parent {beam.parent!r} is not defined before it",
-                where=f"beam {beam.name}",
-                fix="list beams in tree order (parents first)",
-            )
-        hs = [beam.length / DEFAULT_ELEMENTS_PER_BEAM]
-        if elements_per_beam is not None or max_element_length is not None:
-            hs = []
-            if elements_per_beam is not None:
-                hs.append(beam.length / int(elements_per_beam))
-            if max_element_length is not None:
-                hs.append(float(max_element_length))
-        s = _beam_stations(beam, station, min(hs))
-        pos = beam.station_position(s)
-        ref = np.empty(s.size, int)
-        ref[0] = parent_node
-        ref[1:] = [mesh.add(pos[i], f"{beam.name}:n{i}") for i in range(1, s.size)]
-        off = np.zeros((s.size, 3))
-        off[0] = pos[0] - mesh.positions[parent_node]
-        mesh.beam_s[beam.name], mesh.beam_ref[beam.name] = s, ref
-        mesh.beam_off[beam.name] = off
-        ne = s.size - 1
-        el["a"].append(ref[:-1])
-        el["b"].append(ref[1:])
-        el["da"].append(off[:-1])
-        el["db"].append(off[1:])
-        el["len"].append(np.diff(s))
-        el["dir"].append(np.broadcast_to(beam.direction, (ne, 3)))
-        el["ori"].append(np.broadcast_to(beam.orientation, (ne, 3)))
-        ea, gj, rho_j = _effective_properties(beam)
-        props.append(
-            np.broadcast_to([ea, beam.ei_y, beam.ei_z, gj, beam.mass_per_length, rho_j], (ne, 6))
-        )
-        for body in station.bodies:
-            if body.parent == beam.name:
-                attach = body.attach if body.attach is not None else beam.root
-                node, _ = mesh.locate(station, beam.name, attach)
-                mesh.body_node[body.name] = node
-    for body in station.bodies:
-        if body.name not in mesh.body_node:
-            raise InputError(
-                f"body {body.name!r} rides on {body.parent!r}, which is not a beam of the model",
-                where=f"body {body.name}",
-            )
-
-    n_nodes = len(mesh.positions)
+    graph = graph_from_station(
+        station, elements_per_beam=elements_per_beam, max_element_length=max_element_length
+    )
+    fm = assemble_frame(graph)
+    K, M = fm.stiffness, fm.mass
+    P = fm.positions
+    n_nodes = P.shape[0]
     n = 6 * n_nodes
-    P = np.array(mesh.positions).reshape(n_nodes, 3)
-    rows: list[np.ndarray] = []
-    cols: list[np.ndarray] = []
-    kval: list[np.ndarray] = []
-    mval: list[np.ndarray] = []
-
-    if station.beams:
-        a = np.concatenate(el["a"])
-        b = np.concatenate(el["b"])
-        pr = np.concatenate(props)
-        length = np.concatenate(el["len"])
-        kloc = frame_stiffness_local(length, pr[:, 0], pr[:, 1], pr[:, 2], pr[:, 3])
-        mloc = frame_mass_local(length, pr[:, 4], pr[:, 5])
-        R = frame_rotation(np.concatenate(el["dir"]), np.concatenate(el["ori"]))
-        ne = length.size
-        A = np.zeros((ne, 12, 12))
-        ta = rigid_link(np.concatenate(el["da"]))
-        tb = rigid_link(np.concatenate(el["db"]))
-        # A = blockdiag(R, R, R, R) @ blockdiag(T_a, T_b): local DOFs from independent DOFs
-        for blk, t in ((0, ta), (1, tb)):
-            o = 6 * blk
-            A[:, o : o + 3, o : o + 6] = R @ t[:, :3, :]
-            A[:, o + 3 : o + 6, o : o + 6] = R @ t[:, 3:, :]
-        At = np.swapaxes(A, 1, 2)
-        ke = At @ kloc @ A
-        me = At @ mloc @ A
-        dofs = np.concatenate([6 * a[:, None] + np.arange(6), 6 * b[:, None] + np.arange(6)], 1)
-        rows.append(np.broadcast_to(dofs[:, :, None], (ne, 12, 12)).ravel())
-        cols.append(np.broadcast_to(dofs[:, None, :], (ne, 12, 12)).ravel())
-        kval.append(ke.ravel())
-        mval.append(me.ravel())
-
-    # point masses: on bodies (offset from the master), on beams (at their node)
-    carriers: list[tuple[str, PointMass]] = [
-        (bd.name, pm) for bd in station.bodies for pm in bd.masses
-    ]
-    carriers += [(bm.name, pm) for bm in station.beams for pm in bm.masses]
-    if carriers:
-        nodes, offs = zip(
-            *(mesh.locate(station, c, pm.position) for c, pm in carriers), strict=True
-        )
-        pms = [pm for _, pm in carriers]
-        m6 = point_mass_matrix(
-            np.array([pm.mass for pm in pms]),
-            np.array([pm.inertia for pm in pms], float).reshape(-1, 3, 3),
-            np.array(offs),
-        )
-        d6 = 6 * np.asarray(nodes)[:, None] + np.arange(6)
-        rows.append(np.broadcast_to(d6[:, :, None], m6.shape).ravel())
-        cols.append(np.broadcast_to(d6[:, None, :], m6.shape).ravel())
-        mval.append(m6.ravel())
-        kval.append(np.zeros(m6.size))
-
-    r_all = np.concatenate(rows) if rows else np.zeros(0, int)
-    c_all = np.concatenate(cols) if cols else np.zeros(0, int)
-    K = sp.coo_matrix((np.concatenate(kval), (r_all, c_all)), shape=(n, n)).tocsr()
-    M = sp.coo_matrix((np.concatenate(mval), (r_all, c_all)), shape=(n, n)).tocsr()
-    K = 0.5 * (K + K.T)
-    M = 0.5 * (M + M.T)
-    K.eliminate_zeros()
-    M.eliminate_zeros()
+    index = graph.node_index()
 
     total, cm, inertia = _mass_properties(station)
-    root_node = mesh.body_node[station.bodies[0].name]
+    root_node = index[station.bodies[0].name]  # the root body's node is named after it
     root_k = np.zeros(6)
     if gravity_gradient:
         # Eqs. 2.27-2.28 on the root's rotations; negative when I_z is not the smallest
@@ -825,18 +577,29 @@ def build_fem(
         gg = sp.coo_matrix(
             (root_k[3:5], ([6 * root_node + 3, 6 * root_node + 4],) * 2), shape=(n, n)
         )
-        K = (K + gg).tocsr()
+        K = sp.csr_matrix(K + gg)
 
-    labels = tuple(f"{name}:{c}" for name in mesh.names for c in DOF_NAMES)
+    labels = tuple(f"{name}:{c}" for name in fm.names for c in DOF_NAMES)
     rigid = _rigid_vectors(P, cm)
+    carriers = [f"body {b.name}" for b in station.bodies if b.masses]
+    carriers += [f"beam {b.name}" for b in station.beams if b.masses or b.mass_per_length > 0]
+    check_rotary_inertia(M, rigid, carriers)
     tree = None
-    if station.beams:
+    if graph.beams:
+        a = np.array([index[b.nodes[0]] for b in graph.beams])
+        b_ = np.array([index[b.nodes[1]] for b in graph.beams])
+        pr = np.array(
+            [
+                [s.ea_N, s.ei_y_N_m2, s.ei_z_N_m2, s.gj_N_m2]
+                for s in (b.section for b in graph.beams)
+            ]
+        )
         tree = _frame_tree(
             P,
-            np.concatenate(el["a"]),
-            np.concatenate(el["b"]),
-            R,
-            length,
+            a,
+            b_,
+            fm.beam_rotation,
+            fm.beam_length,
             pr,
             root_node,
             root_k,
@@ -847,8 +610,9 @@ def build_fem(
             ),
         )
     points = {}
-    for p in station.points:
-        node, off = mesh.locate(station, p.on, p.position)
+    for p in graph.points:
+        node = index[p.node]
+        off = np.asarray(p.position, float) - P[node]
         tr = np.zeros((3, n))
         rot = np.zeros((3, n))
         tr[:, 6 * node : 6 * node + 3] = np.eye(3)
@@ -858,7 +622,8 @@ def build_fem(
             name=p.name, position=np.asarray(p.position, float), translation=tr, rotation=rot
         )
 
-    samples = _samples(station, mesh, P)
+    n_body_masses = sum(len(b.masses) for b in station.bodies)
+    samples = _samples(P, fm.names, graph.masses[:n_body_masses], index)
     return FrameStructure(
         mass=M,
         stiffness=K,
@@ -875,12 +640,12 @@ def build_fem(
             "model": station.name,
             "source": station.source,
             "n_nodes": n_nodes,
-            "n_elements": int(sum(x.size for x in el["len"])),
+            "n_elements": len(graph.beams),
             "elements_per_beam": elements_per_beam,
             "max_element_length": max_element_length,
             "gravity_gradient": gravity_gradient,
             "node_positions": P,
-            "node_names": tuple(mesh.names),
+            "node_names": tuple(fm.names),
             "assumptions": (
                 f"axially rigid beams: EA = {AXIAL_PENALTY:g} max(EI)/L^2; "
                 f"gj = 0: GJ = {TORSION_PENALTY:g} max(EI); polar mass rho J = m'(EI_y+EI_z)/EA, "
@@ -891,15 +656,6 @@ def build_fem(
         },
         tree=tree,
     )
-
-
-def _mass_properties(station: Station) -> tuple[float, np.ndarray, np.ndarray]:
-    """Station.mass_properties() plus the beams' polar (torsional) mass moments."""
-    total, cm, inertia = station.mass_properties()
-    for bm in station.beams:
-        _, _, rho_j = _effective_properties(bm)
-        inertia = inertia + rho_j * bm.length * np.outer(bm.direction, bm.direction)
-    return total, cm, inertia
 
 
 def _rigid_vectors(P: np.ndarray, center: np.ndarray | None = None) -> dict[str, np.ndarray]:
@@ -926,16 +682,20 @@ def _rigid_vectors(P: np.ndarray, center: np.ndarray | None = None) -> dict[str,
     return out
 
 
-def _samples(station: Station, mesh: _Mesh, P: np.ndarray) -> NodeSamples:
+def _samples(
+    P: np.ndarray,
+    names: Sequence[str],
+    body_masses: Sequence[ConcentratedMass],
+    index: dict[str, int],
+) -> NodeSamples:
+    """Every node, then every body mass at its own position (``"body/mass"`` labels)."""
     nodes = list(range(P.shape[0]))
     offs = [np.zeros(3)] * len(nodes)
-    labels = list(mesh.names)
-    for body in station.bodies:
-        for pm in body.masses:
-            node, off = mesh.locate(station, body.name, pm.position)
-            nodes.append(node)
-            offs.append(off)
-            labels.append(f"{body.name}/{pm.name}")
+    labels = list(names)
+    for gm in body_masses:
+        nodes.append(index[gm.node])
+        offs.append(np.asarray(gm.offset_m, float))
+        labels.append(gm.name)
     nodes_arr = np.asarray(nodes)
     offset = np.array(offs).reshape(-1, 3)
     return NodeSamples(
@@ -944,61 +704,4 @@ def _samples(station: Station, mesh: _Mesh, P: np.ndarray) -> NodeSamples:
         dof_index=6 * nodes_arr[:, None] + np.arange(3),
         rot_index=6 * nodes_arr[:, None] + np.arange(3, 6),
         offset=offset,
-    )
-
-
-# --------------------------------------------------------------------------- helpers
-
-
-def _skew(d: np.ndarray) -> np.ndarray:
-    """Cross-product matrices ``[d]x`` with ``[d]x v = d x v``."""
-    d = np.asarray(d, float)
-    s = np.zeros((*d.shape[:-1], 3, 3))
-    s[..., 0, 1], s[..., 0, 2] = -d[..., 2], d[..., 1]
-    s[..., 1, 0], s[..., 1, 2] = d[..., 2], -d[..., 0]
-    s[..., 2, 0], s[..., 2, 1] = -d[..., 1], d[..., 0]
-    return s
-
-
-def _put2(a: np.ndarray, idx: tuple[int, int], c: np.ndarray, *, mass: bool = False) -> None:
-    i, j = idx
-    diag, off = (2.0, 1.0) if mass else (1.0, -1.0)
-    a[:, i, i] += diag * c
-    a[:, j, j] += diag * c
-    a[:, i, j] += off * c
-    a[:, j, i] += off * c
-
-
-def _put4(a: np.ndarray, idx: tuple[int, ...], c: np.ndarray, block: np.ndarray) -> None:
-    ix = np.asarray(idx)
-    a[:, ix[:, None], ix[None, :]] += c[:, None, None] * block
-
-
-def _bend_k(L: np.ndarray, sign: float) -> np.ndarray:
-    """Hermite bending stiffness pattern (times EI/L^3); sign -1 for the x-z plane."""
-    s = sign
-    one = np.ones_like(L)
-    return np.stack(
-        [
-            np.stack([12 * one, 6 * s * L, -12 * one, 6 * s * L], -1),
-            np.stack([6 * s * L, 4 * L**2, -6 * s * L, 2 * L**2], -1),
-            np.stack([-12 * one, -6 * s * L, 12 * one, -6 * s * L], -1),
-            np.stack([6 * s * L, 2 * L**2, -6 * s * L, 4 * L**2], -1),
-        ],
-        -2,
-    )
-
-
-def _bend_m(L: np.ndarray, sign: float) -> np.ndarray:
-    """Hermite consistent-mass pattern (times rho A L / 420); sign -1 for the x-z plane."""
-    s = sign
-    one = np.ones_like(L)
-    return np.stack(
-        [
-            np.stack([156 * one, 22 * s * L, 54 * one, -13 * s * L], -1),
-            np.stack([22 * s * L, 4 * L**2, 13 * s * L, -3 * L**2], -1),
-            np.stack([54 * one, 13 * s * L, 156 * one, -22 * s * L], -1),
-            np.stack([-13 * s * L, -3 * L**2, -22 * s * L, 4 * L**2], -1),
-        ],
-        -2,
     )

@@ -66,8 +66,9 @@ constraints (NASTRAN SPC) instead, for validation against clamped decks.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterator, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -86,25 +87,26 @@ from microg.models.graph import (
     Spring,
     validate_graph,
 )
-from microg.models.station import Station
-from microg.structure.fem import (
-    DEFAULT_ELEMENTS_PER_BEAM,
-    DOF_NAMES,
-    _beam_stations,
-    _body_reference,
-    _effective_properties,
-    _mass_properties,
-    _Mesh,
-    frame_mass_local,
-    frame_rotation,
-    frame_stiffness_local,
-    point_mass_matrix,
-    rigid_link,
-)
+from microg.models.station import Beam, RigidBody, Station
 from microg.structure.structure import PointMap, Structure
 
 __all__ = [
+    "AXIAL_PENALTY",
     "CONDENSE_MAX",
+    "DEFAULT_ELEMENTS_PER_BEAM",
+    "DOF_NAMES",
+    "GJ_ZERO_FRACTION",
+    "MAX_FEM_DOF",
+    "StationMesh",
+    "TORSION_PENALTY",
+    "frame_mass_local",
+    "frame_rotation",
+    "frame_stiffness_local",
+    "mass_properties_of",
+    "mesh_station",
+    "point_mass_matrix",
+    "rigid_link",
+    "torsion_is_rigid",
     "FrameMatrices",
     "FrameSamples",
     "assemble_frame",
@@ -121,6 +123,17 @@ __all__ = [
     "shear_parameter",
 ]
 
+#: coordinate names of a node, in order
+DOF_NAMES = ("ux", "uy", "uz", "rx", "ry", "rz")
+#: axially rigid beams: EA = AXIAL_PENALTY * max(EI_y, EI_z) / L^2
+AXIAL_PENALTY = 1e6
+#: torsionally rigid beams (gj = 0): GJ = TORSION_PENALTY * max(EI_y, EI_z)
+TORSION_PENALTY = 1e4
+#: a torsional stiffness at most this fraction of max(EI_y, EI_z) is numerically zero and is
+#: treated as gj = 0 (the rule of docs/model-format.md: 1e-30 lbf*ft^2 behaves like 0)
+GJ_ZERO_FRACTION = 1e-12
+#: default number of elements per beam when neither discretisation option is given
+DEFAULT_ELEMENTS_PER_BEAM = 10
 #: largest number of retained DOFs when massless DOFs are condensed (dense K_r)
 CONDENSE_MAX = 2500
 #: an RBE3 whose normal matrix has a condition number above this is singular
@@ -128,6 +141,197 @@ INTERPOLATION_COND_MAX = 1e12
 
 
 # --------------------------------------------------------------------------- kernels
+
+
+def frame_stiffness_local(
+    length: np.ndarray, ea: np.ndarray, ei_y: np.ndarray, ei_z: np.ndarray, gj: np.ndarray
+) -> np.ndarray:
+    """Stiffness matrices of 3-D Euler-Bernoulli frame elements in local axes.
+
+    Local DOF order per node ``(u, v, w, theta_x, theta_y, theta_z)``, node a then node b;
+    ``theta_z = dv/dx`` and ``theta_y = -dw/dx`` (Przemieniecki, *Theory of Matrix
+    Structural Analysis*, Eq. 5.115).
+
+    Parameters
+    ----------
+    length : ndarray (ne,)
+        Element lengths, m.
+    ea : ndarray (ne,)
+        Axial stiffness, N.
+    ei_y, ei_z : ndarray (ne,)
+        Bending stiffness about local y (deflection w) and local z (deflection v), N m^2.
+    gj : ndarray (ne,)
+        Torsional stiffness, N m^2.
+
+    Returns
+    -------
+    ndarray (ne, 12, 12)
+        N/m, N, N m per unit DOF.
+    """
+    L = np.asarray(length, float)
+    k = np.zeros((L.size, 12, 12))
+    _put2(k, (0, 6), np.asarray(ea, float) / L)
+    _put2(k, (3, 9), np.asarray(gj, float) / L)
+    _put4(k, (1, 5, 7, 11), np.asarray(ei_z, float) / L**3, _bend_k(L, +1.0))
+    _put4(k, (2, 4, 8, 10), np.asarray(ei_y, float) / L**3, _bend_k(L, -1.0))
+    return k
+
+
+def frame_mass_local(
+    length: np.ndarray, mass_per_length: np.ndarray, polar_mass_per_length: np.ndarray
+) -> np.ndarray:
+    """Consistent mass matrices of 3-D frame elements in local axes.
+
+    Translational mass from the same cubic (bending) and linear (axial) shape functions as
+    :func:`frame_stiffness_local`; torsional mass ``rho J L / 6 [[2, 1], [1, 2]]``.
+
+    Parameters
+    ----------
+    length : ndarray (ne,)
+        Element lengths, m.
+    mass_per_length : ndarray (ne,)
+        ``rho A``, kg/m.
+    polar_mass_per_length : ndarray (ne,)
+        ``rho J``, polar mass moment per length about the axis, kg m.
+
+    Returns
+    -------
+    ndarray (ne, 12, 12)
+        kg, kg m, kg m^2 per unit DOF.
+    """
+    L = np.asarray(length, float)
+    m = np.zeros((L.size, 12, 12))
+    mL = np.asarray(mass_per_length, float) * L
+    _put2(m, (0, 6), mL / 6.0, mass=True)
+    _put2(m, (3, 9), np.asarray(polar_mass_per_length, float) * L / 6.0, mass=True)
+    _put4(m, (1, 5, 7, 11), mL / 420.0, _bend_m(L, +1.0))
+    _put4(m, (2, 4, 8, 10), mL / 420.0, _bend_m(L, -1.0))
+    return m
+
+
+def frame_rotation(direction: np.ndarray, orientation: np.ndarray) -> np.ndarray:
+    """Rotation matrices from station to element axes (rows: local x, y, z).
+
+    Parameters
+    ----------
+    direction : ndarray (ne, 3)
+        Unit vectors along the elements (local x).
+    orientation : ndarray (ne, 3)
+        Local y axes (made exactly perpendicular to ``direction`` here).
+
+    Returns
+    -------
+    ndarray (ne, 3, 3)
+        ``R`` with ``v_local = R @ v_station``.
+    """
+    ex = np.asarray(direction, float)
+    ex = ex / np.linalg.norm(ex, axis=-1, keepdims=True)
+    ey = np.asarray(orientation, float)
+    ey = ey - np.sum(ey * ex, axis=-1, keepdims=True) * ex
+    ey = ey / np.linalg.norm(ey, axis=-1, keepdims=True)
+    ez = np.cross(ex, ey)
+    return np.stack([ex, ey, ez], axis=-2)
+
+
+def rigid_link(offset: np.ndarray) -> np.ndarray:
+    """Rigid-link matrices: slave-node DOFs from master-node DOFs.
+
+    ``u_s = u_m + theta_m x d`` and ``theta_s = theta_m`` with ``d = x_s - x_m``.
+
+    Parameters
+    ----------
+    offset : ndarray (..., 3)
+        Slave position minus master position, m.
+
+    Returns
+    -------
+    ndarray (..., 6, 6)
+    """
+    d = np.asarray(offset, float)
+    t = np.zeros((*d.shape[:-1], 6, 6))
+    t[..., range(6), range(6)] = 1.0
+    t[..., :3, 3:] = -_skew(d)
+    return t
+
+
+def point_mass_matrix(mass: np.ndarray, inertia: np.ndarray, offset: np.ndarray) -> np.ndarray:
+    """6x6 mass matrices of point masses rigidly attached to a node.
+
+    Parameters
+    ----------
+    mass : ndarray (p,)
+        kg.
+    inertia : ndarray (p, 3, 3)
+        Rotary inertia about each mass's own centre, station axes, kg m^2.
+    offset : ndarray (p, 3)
+        Mass centre minus node position, m.
+
+    Returns
+    -------
+    ndarray (p, 6, 6)
+        ``T^T diag(m I, J) T`` with ``T`` the rigid link (mass, m [d]x coupling and the
+        parallel-axis inertia ``J + m (|d|^2 I - d d^T)``).
+    """
+    m = np.asarray(mass, float)
+    local = np.zeros((m.size, 6, 6))
+    local[:, range(3), range(3)] = m[:, None]
+    local[:, 3:, 3:] = np.asarray(inertia, float)
+    t = rigid_link(offset)
+    return np.swapaxes(t, -1, -2) @ local @ t
+
+
+def _skew(d: np.ndarray) -> np.ndarray:
+    """Cross-product matrices ``[d]x`` with ``[d]x v = d x v``."""
+    d = np.asarray(d, float)
+    s = np.zeros((*d.shape[:-1], 3, 3))
+    s[..., 0, 1], s[..., 0, 2] = -d[..., 2], d[..., 1]
+    s[..., 1, 0], s[..., 1, 2] = d[..., 2], -d[..., 0]
+    s[..., 2, 0], s[..., 2, 1] = -d[..., 1], d[..., 0]
+    return s
+
+
+def _put2(a: np.ndarray, idx: tuple[int, int], c: np.ndarray, *, mass: bool = False) -> None:
+    i, j = idx
+    diag, off = (2.0, 1.0) if mass else (1.0, -1.0)
+    a[:, i, i] += diag * c
+    a[:, j, j] += diag * c
+    a[:, i, j] += off * c
+    a[:, j, i] += off * c
+
+
+def _put4(a: np.ndarray, idx: tuple[int, ...], c: np.ndarray, block: np.ndarray) -> None:
+    ix = np.asarray(idx)
+    a[:, ix[:, None], ix[None, :]] += c[:, None, None] * block
+
+
+def _bend_k(L: np.ndarray, sign: float) -> np.ndarray:
+    """Hermite bending stiffness pattern (times EI/L^3); sign -1 for the x-z plane."""
+    s = sign
+    one = np.ones_like(L)
+    return np.stack(
+        [
+            np.stack([12 * one, 6 * s * L, -12 * one, 6 * s * L], -1),
+            np.stack([6 * s * L, 4 * L**2, -6 * s * L, 2 * L**2], -1),
+            np.stack([-12 * one, -6 * s * L, 12 * one, -6 * s * L], -1),
+            np.stack([6 * s * L, 2 * L**2, -6 * s * L, 4 * L**2], -1),
+        ],
+        -2,
+    )
+
+
+def _bend_m(L: np.ndarray, sign: float) -> np.ndarray:
+    """Hermite consistent-mass pattern (times rho A L / 420); sign -1 for the x-z plane."""
+    s = sign
+    one = np.ones_like(L)
+    return np.stack(
+        [
+            np.stack([156 * one, 22 * s * L, 54 * one, -13 * s * L], -1),
+            np.stack([22 * s * L, 4 * L**2, 13 * s * L, -3 * L**2], -1),
+            np.stack([54 * one, 13 * s * L, 156 * one, -22 * s * L], -1),
+            np.stack([-13 * s * L, -3 * L**2, -22 * s * L, 4 * L**2], -1),
+        ],
+        -2,
+    )
 
 
 def shear_parameter(length: np.ndarray, ei: np.ndarray, shear: np.ndarray | None) -> np.ndarray:
@@ -501,6 +705,11 @@ class FrameMatrices:
         ``u_g = transform @ u_ind``: the rigid links and interpolations eliminated.
     independent : ndarray of int
         The g-set DOFs kept as coordinates of ``transform``.
+    beam_rotation : ndarray (nb, 3, 3)
+        Station-to-element rotation of each beam element (rows: local x, y, z; the principal
+        bending axes of a skewed section), in the order of ``graph.beams``.
+    beam_length : ndarray (nb,)
+        Length of each beam element between its (offset) ends, m.
     """
 
     stiffness: sp.csr_matrix
@@ -511,6 +720,8 @@ class FrameMatrices:
     names: tuple[str, ...]
     transform: sp.csr_matrix
     independent: np.ndarray
+    beam_rotation: np.ndarray = field(default_factory=lambda: np.zeros((0, 3, 3)))
+    beam_length: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
 
 @dataclass(frozen=True)
@@ -694,6 +905,13 @@ def assemble_frame(graph: GraphModel, *, mass: str | None = None) -> FrameMatric
     index = graph.node_index()
     P = np.array([n.position for n in graph.nodes], float).reshape(-1, 3)
     n = 6 * P.shape[0]
+    if n > MAX_FEM_DOF:
+        raise InputError(
+            f"the frame model has {n:,} degrees of freedom ({P.shape[0]:,} nodes), beyond the "
+            f"limit of {MAX_FEM_DOF:,}",
+            where=graph.source or graph.name,
+            fix="use a coarser mesh, or a modal model of the structure",
+        )
     rk: list[np.ndarray] = []
     ck: list[np.ndarray] = []
     vk: list[np.ndarray] = []
@@ -707,6 +925,8 @@ def assemble_frame(graph: GraphModel, *, mass: str | None = None) -> FrameMatric
     cg: list[np.ndarray] = []
     vg: list[np.ndarray] = []
 
+    beam_R = np.zeros((0, 3, 3))
+    beam_L = np.zeros(0)
     if graph.beams:
         bm = graph.beams
         a = np.array([index[b.nodes[0]] for b in bm])
@@ -719,6 +939,7 @@ def assemble_frame(graph: GraphModel, *, mass: str | None = None) -> FrameMatric
         R = frame_rotation(axis / L[:, None], np.array([b.orientation for b in bm], float))
         secs = [b.section for b in bm]
         R, ei_y, ei_z, skew = _principal(R, secs)
+        beam_R, beam_L = R, L
         sy = np.array([np.inf if s.shear_y_N is None else s.shear_y_N for s in secs])
         sz = np.array([np.inf if s.shear_z_N is None else s.shear_z_N for s in secs])
         sy[skew] = np.inf  # NASTRAN: shear factors ignored when I12 != 0
@@ -822,7 +1043,7 @@ def assemble_frame(graph: GraphModel, *, mass: str | None = None) -> FrameMatric
     C = _coo(rc, cc, vc, n)
     G = _coo(rg, cg, vg, n)
     T, ind = _link_transform(graph, P, index)
-    return FrameMatrices(K, M, C, G, P, tuple(nd.name for nd in nodes), T, ind)
+    return FrameMatrices(K, M, C, G, P, tuple(nd.name for nd in nodes), T, ind, beam_R, beam_L)
 
 
 def _basic_dofs(node: Node, comps: str, *, where: str) -> list[int]:
@@ -947,7 +1168,11 @@ def _chain_solve(A: sp.csc_matrix, B: sp.csc_matrix) -> sp.csr_matrix:
 
 
 def _mass_props(M: Any, r: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
-    """Total mass, centre of mass and inertia about it from M and the rigid vectors (n, 6)."""
+    """Total mass, centre of mass and inertia about it from M and the rigid vectors (n, 6).
+
+    The rotations of ``r`` are about a reference point; the centre of mass is returned
+    relative to it.
+    """
     mrr = np.asarray(r.T @ (M @ r))
     mrr = 0.5 * (mrr + mrr.T)
     total = float(np.trace(mrr[:3, :3]) / 3.0)
@@ -957,6 +1182,33 @@ def _mass_props(M: Any, r: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
     cm = first / total
     inertia = mrr[3:, 3:] - total * (float(cm @ cm) * np.eye(3) - np.outer(cm, cm))
     return total, cm, 0.5 * (inertia + inertia.T)
+
+
+def mass_properties_of(
+    M: Any, positions: np.ndarray, dofs: np.ndarray | None = None
+) -> tuple[float, np.ndarray, np.ndarray]:
+    """Total mass (kg), centre of mass (m) and inertia about it (kg m^2) of a frame model.
+
+    ``r^T M r`` for the exact rigid-body vectors ``r`` about the model's mean node, then
+    about the centre of mass so found (lever arms formed once, from each node's offset to
+    that point: a model 5 km from the origin loses nothing to the shift).
+
+    Parameters
+    ----------
+    M : sparse (n, n)
+        Mass matrix on the DOFs ``dofs`` of the 6-DOF nodes at ``positions``.
+    positions : ndarray (nn, 3)
+        Node positions, m.
+    dofs : ndarray of int, optional
+        The node DOFs (``6 node + k``) the coordinates are (default: all, in order).
+    """
+    P = np.asarray(positions, float)
+    sel = slice(None) if dofs is None else np.asarray(dofs)
+    c0 = P.mean(axis=0) if P.size else np.zeros(3)
+    total, d, _ = _mass_props(M, rigid_link(P - c0).reshape(-1, 6)[sel])
+    cm = c0 + d
+    total, d2, inertia = _mass_props(M, rigid_link(P - cm).reshape(-1, 6)[sel])
+    return total, cm + d2, inertia
 
 
 def build_frame(
@@ -1086,10 +1338,13 @@ def build_frame(
         G_out = Gn[retained][:, retained].tocsr()
     labels = tuple(ind_labels[i] for i in retained)
 
-    # mass properties from the unconstrained mass and the exact rigid vectors about the origin
+    # mass properties from the unconstrained mass and the exact rigid vectors about a point
+    # of the model (its mean node: lever arms of the model's size, not of its distance from
+    # the origin, whose rounding would cancel in the shift to the centre of mass)
     P = fm.positions
-    r_origin = rigid_link(P).reshape(-1, 6)[fm.independent]  # columns x y z rx ry rz
-    total, cm, inertia = _mass_props(fm.transform.T @ fm.mass @ fm.transform, r_origin)
+    total, cm, inertia = mass_properties_of(
+        fm.transform.T @ fm.mass @ fm.transform, P, fm.independent
+    )
     # rigid-body vectors: exact unit motions about the centre of mass (lever arms formed once,
     # as microg.structure.fem does), restricted to the retained coordinates
     r_ind = rigid_link(P - cm).reshape(-1, 6)[fm.independent]
@@ -1313,33 +1568,177 @@ def _samples(
     )
 
 
+# --------------------------------------------------------------------------- station mesher
+
+
+@dataclass
+class _Mesh:
+    """Working state of the mesher (private)."""
+
+    positions: list[np.ndarray] = field(default_factory=list)
+    names: list[str] = field(default_factory=list)
+    body_node: dict[str, int] = field(default_factory=dict)
+    beam_s: dict[str, np.ndarray] = field(default_factory=dict)
+    beam_ref: dict[str, np.ndarray] = field(default_factory=dict)
+    beam_off: dict[str, np.ndarray] = field(default_factory=dict)
+
+    def add(self, position: np.ndarray, name: str) -> int:
+        self.positions.append(np.asarray(position, float))
+        self.names.append(name)
+        return len(self.positions) - 1
+
+    def locate(
+        self, station: Station, component: str, position: np.ndarray
+    ) -> tuple[int, np.ndarray]:
+        """Independent node carrying ``position`` on ``component``, and the offset to it."""
+        position = np.asarray(position, float)
+        if component in self.body_node:
+            node = self.body_node[component]
+        elif component in self.beam_s:
+            beam = station.component(component)
+            assert isinstance(beam, Beam)  # beam_s holds only beams
+            k = int(np.argmin(np.abs(self.beam_s[component] - beam.arc_length(position))))
+            node = int(self.beam_ref[component][k])
+        else:
+            raise InputError(
+                f"component {component!r} is not meshed (not in tree order)",
+                fix="list every beam after its parent and every body after its carrier beam",
+            )
+        return node, position - self.positions[node]
+
+
+def _beam_stations(beam: Beam, station: Station, h: float) -> np.ndarray:
+    """Arc lengths of the nodes of ``beam``: breakpoints kept, segments split evenly."""
+    L = beam.length
+    cuts = [0.0, L]
+    cuts += [beam.arc_length(pm.position) for pm in beam.masses]
+    cuts += [beam.arc_length(p.position) for p in station.points if p.on == beam.name]
+    cuts += [beam.arc_length(b.root) for b in station.beams if b.parent == beam.name]
+    cuts += [
+        beam.arc_length(b.attach)
+        for b in station.bodies
+        if b.parent == beam.name and b.attach is not None
+    ]
+    cuts_arr = np.unique(np.clip(np.asarray(cuts, float), 0.0, L))
+    keep = np.concatenate([[True], np.diff(cuts_arr) > 1e-9 * L])
+    cuts_arr = cuts_arr[keep]
+    cuts_arr[-1] = L
+    out = [np.zeros(1)]
+    for a, b in zip(cuts_arr[:-1], cuts_arr[1:], strict=True):
+        n = max(1, math.ceil((b - a) / h - 1e-9))
+        out.append(np.linspace(a, b, n + 1)[1:])
+    return np.concatenate(out)
+
+
+def _body_reference(body: RigidBody, station: Station) -> np.ndarray:
+    for bm in station.beams:
+        if bm.parent == body.name:
+            return np.asarray(bm.root, float)
+    if body.masses:
+        m = np.array([pm.mass for pm in body.masses])
+        p = np.array([pm.position for pm in body.masses], float)
+        return m @ p / m.sum()
+    return np.zeros(3)
+
+
+def torsion_is_rigid(beam: Beam) -> bool:
+    """True when ``beam``'s torsional stiffness is zero or numerically zero.
+
+    The rule (docs/model-format.md): ``gj <= GJ_ZERO_FRACTION max(EI_y, EI_z)`` is treated
+    exactly like ``gj = 0``, i.e. torsionally rigid.
+
+    Parameters
+    ----------
+    beam : Beam
+    """
+    return not beam.gj > GJ_ZERO_FRACTION * max(beam.ei_y, beam.ei_z)
+
+
+def _effective_properties(beam: Beam) -> tuple[float, float, float]:
+    """Axial stiffness (N), torsional stiffness (N m^2) and rho J (kg m) used for ``beam``."""
+    ei_max = max(beam.ei_y, beam.ei_z)
+    ea = beam.ea if beam.ea is not None else AXIAL_PENALTY * ei_max / beam.length**2
+    gj = TORSION_PENALTY * ei_max if torsion_is_rigid(beam) else beam.gj
+    return float(ea), float(gj), beam.polar_mass_per_length
+
+
+def _mass_properties(station: Station) -> tuple[float, np.ndarray, np.ndarray]:
+    """Station.mass_properties() plus the beams' polar (torsional) mass moments."""
+    total, cm, inertia = station.mass_properties()
+    for bm in station.beams:
+        _, _, rho_j = _effective_properties(bm)
+        inertia = inertia + rho_j * bm.length * np.outer(bm.direction, bm.direction)
+    return total, cm, inertia
+
+
 # --------------------------------------------------------------------------- station -> graph
 
 
-def graph_from_station(
+#: largest frame model (degrees of freedom, 6 per node) a station is meshed into: checked
+#: before any node is made.  A 500,000-DOF sparse model takes ~0.5 GB for its matrices and
+#: 60 modes (~6 s to solve on this project's machine, 1 thread); the shipped IOC model has
+#: ~42,000 nodes (250,000 DOFs) at the CLI's largest --elements 10,000.
+MAX_FEM_DOF = 500_000
+
+
+@dataclass
+class StationMesh:
+    """The one meshing of a tree-of-beams station (nodes and beam elements), before assembly.
+
+    Attributes
+    ----------
+    mesh : _Mesh
+        Node positions and names, the node of each body, each beam's node arc lengths and
+        nodes.
+    elements : list of tuple
+        ``(beam, e, node_a, node_b, offset_a)`` per element, in tree order (parents first):
+        element ``e`` of ``beam`` from node ``a`` to node ``b``; ``offset_a`` is the rigid
+        offset from node ``a`` to the element's start (non-zero for a beam's root on a body).
+    """
+
+    mesh: _Mesh
+    elements: list[tuple[Beam, int, int, int, np.ndarray]]
+
+
+def _element_size(
+    beam: Beam, elements_per_beam: int | None, max_element_length: float | None
+) -> float:
+    """Target element length of ``beam``, m: the finer of the two options (default 10)."""
+    if elements_per_beam is None and max_element_length is None:
+        return beam.length / DEFAULT_ELEMENTS_PER_BEAM
+    hs = [] if elements_per_beam is None else [beam.length / int(elements_per_beam)]
+    if max_element_length is not None:
+        hs.append(float(max_element_length))
+    return min(hs)
+
+
+def mesh_station(
     station: Station,
     *,
     elements_per_beam: int | None = None,
     max_element_length: float | None = None,
-    gravity_gradient: bool = False,
-) -> GraphModel:
-    """The tree-of-beams station as a graph model, meshed as ``build_fem`` meshes it.
+) -> StationMesh:
+    """Mesh a tree station: nodes at bodies, joints, masses and points, beams cut evenly.
 
-    The same nodes (names ``body`` and ``beam:nK``), the same Euler-Bernoulli elements with
-    consistent mass and the same effective properties (penalty EA for axially rigid beams,
-    GJ for ``gj = 0``, polar mass moment), beam roots on bodies as rigid end offsets, point
-    masses as concentrated masses at their nodes, named points riding on their nodes, and
-    the gravity-gradient stiffness (``gravity_gradient=True``) as a grounded spring on the
-    root body's rotations.  :func:`build_frame` of the result therefore has the same
-    matrices as ``build_fem`` (node for node).
+    A root body's node is at the root of its first beam (else at its masses' centre of
+    mass); a body riding on a beam shares the beam's node at its attach point; a beam on a
+    beam starts at the carrier's node nearest its root.  Every beam is cut at its masses,
+    points and joints, and each segment evenly into elements no longer than the target
+    (:func:`_element_size`).
 
     Parameters
     ----------
     station : Station
-    elements_per_beam, max_element_length : optional
-        As for :func:`~microg.structure.fem.build_fem`.
-    gravity_gradient : bool
-        Add the libration stiffness of Eqs. 2.27-2.28 on the root body's rotations.
+    elements_per_beam : int, optional
+        Minimum number of elements per beam.
+    max_element_length : float, optional
+        Largest element length, m.
+
+    Raises
+    ------
+    InputError
+        A mesh beyond :data:`MAX_FEM_DOF` (checked before any node is made), or a model
+        not in tree order.
     """
     if not station.bodies:
         raise InputError("the station has no rigid body", fix="add a root [[body]]")
@@ -1349,11 +1748,27 @@ def graph_from_station(
     ):
         if v is not None and not (v > 0):
             raise InputError(f"{what} must be positive, got {v!r}", where=what)
+    # the size before the mesh: a bound from the options alone, then the exact count
+    n_bodies = sum(1 for b in station.bodies if b.parent is None)
+    estimate = n_bodies + sum(
+        beam.length / _element_size(beam, elements_per_beam, max_element_length)
+        for beam in station.beams
+    )
+    if 6.0 * estimate > 2.0 * MAX_FEM_DOF:
+        _too_many(6.0 * estimate, elements_per_beam, max_element_length, station)
+    stations = {}
+    for beam in station.beams:
+        h = _element_size(beam, elements_per_beam, max_element_length)
+        stations[beam.name] = _beam_stations(beam, station, h)
+    n_dof = 6 * (n_bodies + sum(s.size - 1 for s in stations.values()))
+    if n_dof > MAX_FEM_DOF:
+        _too_many(n_dof, elements_per_beam, max_element_length, station)
+
     mesh = _Mesh()
     for body in station.bodies:
         if body.parent is None:
             mesh.body_node[body.name] = mesh.add(_body_reference(body, station), body.name)
-    beams: list[BeamElement] = []
+    elements: list[tuple[Beam, int, int, int, np.ndarray]] = []
     for beam in station.beams:
         if beam.parent in mesh.body_node:
             parent_node = mesh.body_node[beam.parent]
@@ -1365,34 +1780,17 @@ def graph_from_station(
                 where=f"beam {beam.name}",
                 fix="list beams in tree order (parents first)",
             )
-        hs = [beam.length / DEFAULT_ELEMENTS_PER_BEAM]
-        if elements_per_beam is not None or max_element_length is not None:
-            hs = [beam.length / int(elements_per_beam)] if elements_per_beam is not None else []
-            if max_element_length is not None:
-                hs.append(float(max_element_length))
-        s = _beam_stations(beam, station, min(hs))
+        s = stations[beam.name]
         pos = beam.station_position(s)
         ref = np.empty(s.size, int)
         ref[0] = parent_node
         ref[1:] = [mesh.add(pos[i], f"{beam.name}:n{i}") for i in range(1, s.size)]
         mesh.beam_s[beam.name], mesh.beam_ref[beam.name] = s, ref
         mesh.beam_off[beam.name] = np.zeros((s.size, 3))
-        ea, gj, rho_j = _effective_properties(beam)
-        sec = BeamSection(beam.name, ea, beam.ei_y, beam.ei_z, gj, beam.mass_per_length, rho_j)
         root_off = pos[0] - mesh.positions[parent_node]
         for e in range(s.size - 1):
-            off = np.zeros((2, 3))
-            if e == 0:
-                off[0] = root_off
-            beams.append(
-                BeamElement(
-                    f"{beam.name}:e{e}",
-                    (mesh.names[ref[e]], mesh.names[ref[e + 1]]),
-                    sec,
-                    np.asarray(beam.orientation, float),
-                    off,
-                )
-            )
+            off_a = root_off if e == 0 else np.zeros(3)
+            elements.append((beam, e, int(ref[e]), int(ref[e + 1]), off_a))
         for body in station.bodies:
             if body.parent == beam.name:
                 attach = body.attach if body.attach is not None else beam.root
@@ -1404,6 +1802,81 @@ def graph_from_station(
                 f"body {body.name!r} rides on {body.parent!r}, which is not a beam of the model",
                 where=f"body {body.name}",
             )
+    return StationMesh(mesh, elements)
+
+
+def _too_many(
+    n_dof: float,
+    elements_per_beam: int | None,
+    max_element_length: float | None,
+    station: Station,
+) -> None:
+    """Refuse a mesh beyond :data:`MAX_FEM_DOF`, naming the option and the largest value."""
+    where = "elements_per_beam" if elements_per_beam is not None else "max_element_length"
+    n_beams = max(len(station.beams), 1)
+    most = max(1, int(MAX_FEM_DOF / (6 * 1.05 * n_beams)))
+    if elements_per_beam is not None:
+        fix = f"use at most ~{most} elements per beam for this model"
+    else:
+        total = sum(b.length for b in station.beams)
+        fix = f"use a max_element_length of at least ~{1.05 * total * 6 / MAX_FEM_DOF:.3g} m"
+    raise InputError(
+        f"the frame mesh would have ~{n_dof:.3g} degrees of freedom, beyond the limit of "
+        f"{MAX_FEM_DOF:,}",
+        where=where,
+        fix=fix,
+    )
+
+
+def graph_from_station(
+    station: Station,
+    *,
+    elements_per_beam: int | None = None,
+    max_element_length: float | None = None,
+    gravity_gradient: bool = False,
+) -> GraphModel:
+    """The tree-of-beams station as a graph model, meshed by :func:`mesh_station`.
+
+    Nodes named ``body`` and ``beam:nK``; Euler-Bernoulli elements with consistent mass and
+    the station's effective properties (penalty EA for axially rigid beams, GJ for
+    ``gj = 0``, polar mass moment: :func:`_effective_properties`); beam roots on bodies as
+    rigid end offsets; point masses as concentrated masses at their nodes (named
+    ``carrier/mass``, bodies' first); named points riding on their nodes; and the
+    gravity-gradient stiffness (``gravity_gradient=True``) as a grounded spring on the root
+    body's rotations.  :func:`microg.structure.fem.build_fem` assembles this graph (its
+    tree solver is the same model's exact flexibility), and :func:`build_frame` of it has
+    the same matrices.
+
+    Parameters
+    ----------
+    station : Station
+    elements_per_beam, max_element_length : optional
+        As for :func:`mesh_station`.
+    gravity_gradient : bool
+        Add the libration stiffness of Eqs. 2.27-2.28 on the root body's rotations (a
+        stable attitude only: a spring cannot be negative; ``build_fem`` reports an
+        unstable one as an unstable mode).
+    """
+    sm = mesh_station(
+        station, elements_per_beam=elements_per_beam, max_element_length=max_element_length
+    )
+    mesh = sm.mesh
+    sections: dict[str, BeamSection] = {}
+    for beam in station.beams:
+        ea, gj, rho_j = _effective_properties(beam)
+        sections[beam.name] = BeamSection(
+            beam.name, ea, beam.ei_y, beam.ei_z, gj, beam.mass_per_length, rho_j
+        )
+    beams = [
+        BeamElement(
+            f"{beam.name}:e{e}",
+            (mesh.names[a], mesh.names[b]),
+            sections[beam.name],
+            np.asarray(beam.orientation, float),
+            np.stack([off_a, np.zeros(3)]),
+        )
+        for beam, e, a, b, off_a in sm.elements
+    ]
     masses: list[ConcentratedMass] = []
     carriers = [(bd.name, pm) for bd in station.bodies for pm in bd.masses]
     carriers += [(bm.name, pm) for bm in station.beams for pm in bm.masses]
