@@ -31,7 +31,7 @@ import numpy as np
 
 from microg.errors import InputError, MicrogError
 from microg.study.kernel import Basis, BlockWork, KernelPlan, kernel_plan, run_blocks, solve_basis
-from microg.study.plan import Block, Study, load_study
+from microg.study.plan import Block, Study, default_n_modes, load_study
 from microg.study.store import STORE_NAME, SweepStore
 
 if TYPE_CHECKING:
@@ -167,7 +167,7 @@ class SweepResult:
         f = s.forces[s.coords["force"].index(case["force"])]
         d = s.directions[s.coords["direction"].index(case["direction"])]
         disc, rec = s.discretisation, s.record
-        n_modes = disc.n_modes or _n_modes(s)
+        n_modes = disc.n_modes or default_n_modes(s)
         if f.catalogue is not None:
             return analyze(
                 self.case_model(case["model"], case["variant"]),
@@ -206,17 +206,6 @@ class SweepResult:
 
 
 # ----------------------------------------------------------------------------- planning
-
-
-def _n_modes(study: Study) -> int | None:
-    """The modes a sparse model's solve asks for when the study names none: the analysis'
-    default, or its default with sources when the study has source catalogues (so that the
-    per-case path solves the same modes)."""
-    if not any(f.catalogue is not None for f in study.forces):
-        return None
-    from microg.analysis import DEFAULT_SOURCE_MODES
-
-    return int(DEFAULT_SOURCE_MODES)
 
 
 def _tasks(study: Study, blocks: Sequence[Block]) -> dict[tuple[int, int], list[list[BlockWork]]]:
@@ -418,42 +407,96 @@ def _client(workers: int | None, scheduler: str | None, timeout_s: float) -> Ite
         cluster.close()
 
 
+#: times a task whose scattered inputs were lost with a worker is resubmitted
+RESUBMIT = 3
+
+
+def _lost(exc: BaseException) -> bool:
+    """True when a task failed because a worker (and the data it held) was lost."""
+    from asyncio import CancelledError
+
+    return isinstance(exc, CancelledError | KeyError | OSError) or "lost" in str(exc).lower()
+
+
+def _scatter(client: Any, data: Any, broadcast: bool) -> Any:
+    """``client.scatter``, again after a moment if a worker is leaving (a restart is racing)."""
+    import time
+
+    for attempt in range(5):
+        try:
+            return client.scatter(data, broadcast=broadcast, hash=False)
+        except (KeyError, OSError):
+            if attempt == 4:
+                raise
+            time.sleep(0.5 * (attempt + 1))
+    raise AssertionError("unreachable")  # pragma: no cover
+
+
 def _distributed(runner: _Runner, client: Any, task_fn: TaskFn, threads: int) -> None:
+    """The sweep on a Dask cluster (see the module docstring).
+
+    Scattered data has no lineage: when a worker dies with the only copy of a variant's
+    basis (or of the plan, or of a model not yet solved), the tasks needing it fail as
+    cancelled; they are resubmitted with the data scattered again (:data:`RESUBMIT` times).
+    """
+    from asyncio import CancelledError
+
     from distributed import as_completed
 
     s = runner.study
-    plan_f = client.scatter(kernel_plan(s), broadcast=True)
+    plan = kernel_plan(s)
+    shared: dict[str, Any] = {"plan": _scatter(client, plan, True)}
+    bases: dict[tuple[int, int], Basis] = {}
+    basis_f: dict[tuple[int, int], Any] = {}
     n_threads = max(1, sum(client.nthreads().values()))
     limit = IN_FLIGHT_PER_THREAD * n_threads
-    meta: dict[str, tuple[str, Any]] = {}
+    meta: dict[str, tuple[str, tuple[int, int], Any, int]] = {}
     ac = as_completed()
-    for im, iv in runner.tasks:
-        model, kw = _solve_args(s, im, iv)
-        model_f = client.scatter(model)  # a model may be large (a modal file's shapes)
+
+    def solve(key: tuple[int, int], attempt: int) -> None:
+        model, kw = _solve_args(s, *key)
+        model_f = _scatter(client, model, False)  # a model may be large (a modal file's shapes)
         f = client.submit(solve_basis, model_f, threads=threads, pure=False, retries=RETRIES, **kw)
-        meta[f.key] = ("basis", (im, iv))
+        meta[f.key] = ("basis", key, None, attempt)
         ac.add(f)
-    queue: deque[tuple[Any, list[BlockWork]]] = deque()
+
+    def submit(key: tuple[int, int], works: list[BlockWork], attempt: int) -> None:
+        f = client.submit(task_fn, basis_f[key], shared["plan"], works, threads, pure=False,
+                          retries=RETRIES)  # fmt: skip
+        meta[f.key] = ("blocks", key, works, attempt)
+        ac.add(f)
+
+    for key in runner.tasks:
+        solve(key, 0)
+    queue: deque[tuple[tuple[int, int], list[BlockWork]]] = deque()
     in_flight = 0
     try:
         for fut in ac:
-            kind, payload = meta.pop(fut.key)
-            result = fut.result()
-            fut.release()
+            kind, key, works, attempt = meta.pop(fut.key)
+            try:
+                result = fut.result()
+            except (Exception, CancelledError) as exc:  # CancelledError is no Exception
+                if not _lost(exc) or attempt >= RESUBMIT:
+                    raise
+                if kind == "basis":
+                    solve(key, attempt + 1)
+                else:  # the data may be gone with the worker: scatter it again
+                    shared["plan"] = _scatter(client, plan, True)
+                    basis_f[key] = _scatter(client, bases[key], True)
+                    submit(key, works, attempt + 1)
+                continue
+            finally:
+                fut.release()
             if kind == "basis":
-                im, iv = payload
                 runner.basis_done(result)
-                basis_f = client.scatter(result, broadcast=True)
-                queue.extend((basis_f, works) for works in runner.tasks[(im, iv)])
+                bases[key] = result
+                basis_f[key] = _scatter(client, result, True)
+                queue.extend((key, w) for w in runner.tasks[key])
             else:
                 in_flight -= 1
                 runner.results(result)
             while queue and in_flight < limit:
-                basis_f, works = queue.popleft()
-                f = client.submit(task_fn, basis_f, plan_f, works, threads, pure=False,
-                                  retries=RETRIES)  # fmt: skip
-                meta[f.key] = ("blocks", None)
-                ac.add(f)
+                submit(*queue.popleft(), 0)
                 in_flight += 1
     except BaseException:
         for f in list(ac.futures):

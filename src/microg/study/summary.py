@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from microg.errors import InputError
-from microg.study.plan import CASE_DIMS, Study
+from microg.study.plan import CASE_DIMS, Study, default_n_modes
 
 if TYPE_CHECKING:
     from microg.study.run import SweepResult
@@ -372,9 +372,7 @@ def case_command(result: SweepResult, labels: dict[str, Any]) -> str | None:
         args += ["--plane", d.plane]
     if d.n is not None:
         args += ["--elements", str(d.n)]
-    from microg.study.run import _n_modes
-
-    n_modes = d.n_modes or _n_modes(study)
+    n_modes = d.n_modes or default_n_modes(study)
     if n_modes is not None:
         args += ["--n-modes", str(n_modes)]
     if d.gravity_gradient:
@@ -386,8 +384,6 @@ def case_command(result: SweepResult, labels: dict[str, Any]) -> str | None:
 
 def case_python(result: SweepResult, labels: dict[str, Any]) -> str:
     """The Python call that reproduces one case alone with :func:`microg.analyze`."""
-    from microg.study.run import _n_modes
-
     study = result.study
     _, model = _model_ref(result, labels)
     d, r = study.discretisation, study.record
@@ -401,7 +397,7 @@ def case_python(result: SweepResult, labels: dict[str, Any]) -> str:
     return (
         f"microg.analyze({model}, {what}, observe=[{labels['observe']!r}], "
         f"damping={float(labels['damping'])!r}, method={d.method!r}, plane={d.plane!r}, "
-        f"n={d.n!r}, n_modes={d.n_modes or _n_modes(study)!r}, "
+        f"n={d.n!r}, n_modes={d.n_modes or default_n_modes(study)!r}, "
         f"gravity_gradient={d.gravity_gradient!r}, max_freq={r.max_freq_hz!r}, "
         f"duration={r.duration_s!r}, dt={r.dt_s!r}, requirement={r.requirement!r})"
     )
