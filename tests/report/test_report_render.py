@@ -54,8 +54,11 @@ os.kill(r._pid, 9)
 out["killed"] = [r.render(one, 1), r.error is not None]
 r = FigureRenderer.start((), processes=2)
 out["tiny"] = r.render(one, 1)
-r = FigureRenderer.start((), processes=2)
-r.close()  # started and never used: the helper stops
+import time
+r = FigureRenderer.start(rep.PRELOAD, processes=2)  # busy importing matplotlib
+t = time.monotonic()
+r.close()  # started and never used (an input error, say): the helper stops at once
+out["close_s"] = time.monotonic() - t
 out["closed"] = r.active
 try:
     os.waitpid(-1, os.WNOHANG)
@@ -91,6 +94,7 @@ def test_a_failing_helper_means_drawing_in_process(forked):
 def test_helpers_share_the_jobs_and_stop(forked):
     assert forked["tiny"] == ["a.png", "b.png"]  # two jobs, one in each process, in order
     assert forked["closed"] is False
+    assert forked["close_s"] < 0.5  # not waiting for the helper's imports (~0.5-1 s)
     assert forked["children_left"] is False  # every helper reaped
 
 

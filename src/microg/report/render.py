@@ -31,6 +31,7 @@ import sys
 import threading
 import time
 import traceback
+import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from types import TracebackType
@@ -253,7 +254,11 @@ class FigureRenderer:
         sys.stdout.flush()
         sys.stderr.flush()
         try:
-            pid = os.fork()
+            with warnings.catch_warnings():
+                # Python >= 3.12 warns of fork with threads running: BLAS's idle pool, which
+                # OpenBLAS stops and restarts around a fork itself (pthread_atfork)
+                warnings.simplefilter("ignore", DeprecationWarning)
+                pid = os.fork()
         except OSError:
             for fd in (req_r, req_w, rep_r, rep_w):
                 os.close(fd)
@@ -318,16 +323,17 @@ class FigureRenderer:
         pid, self._pid = self._pid, None
         if pid is None:
             return
-        # the helper exits by itself on end of file; wait briefly, then make sure
-        deadline = time.monotonic() + 2.0
-        while time.monotonic() < deadline:
-            if _exited(pid):
+        # a helper that replied is exiting; one that never got work is killed at once (it
+        # holds nothing: an error exit must not wait for its imports)
+        deadline = time.monotonic() + 0.05
+        while not _exited(pid):
+            if time.monotonic() > deadline:
+                with contextlib.suppress(ProcessLookupError):
+                    os.kill(pid, signal.SIGKILL)
+                with contextlib.suppress(ChildProcessError):
+                    os.waitpid(pid, 0)
                 return
-            time.sleep(0.005)
-        with contextlib.suppress(ProcessLookupError):
-            os.kill(pid, signal.SIGKILL)
-        with contextlib.suppress(ChildProcessError):
-            os.waitpid(pid, 0)
+            time.sleep(0.002)
 
     def __enter__(self) -> FigureRenderer:
         return self
