@@ -33,6 +33,8 @@ if TYPE_CHECKING:
     from microg.models.station import Station
     from microg.structure.discretize import discretize
     from microg.structure.structure import Structure
+    from microg.study.plan import load_study
+    from microg.study.run import SweepResult, sweep
 
 __version__ = "0.2.0"
 
@@ -50,6 +52,9 @@ _LAZY: dict[str, str] = {
     "Modes": "microg.dynamics.modes:Modes",
     "ForceHistory": "microg.dynamics.forces:ForceHistory",
     "crew_pushoff": "microg.dynamics.forces:crew_pushoff",
+    "sweep": "microg.study.run:sweep",
+    "SweepResult": "microg.study.run:SweepResult",
+    "load_study": "microg.study.plan:load_study",
 }
 
 __all__ = [
@@ -65,13 +70,16 @@ __all__ = [
     "SolverError",
     "Station",
     "Structure",
+    "SweepResult",
     "__version__",
     "analyze",
     "crew_pushoff",
     "discretize",
     "load_model",
     "load_station",
+    "load_study",
     "solve_modes",
+    "sweep",
 ]
 
 
