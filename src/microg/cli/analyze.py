@@ -181,7 +181,7 @@ def _weight_to_mass(text: str) -> str:
     "points_file",
     type=click.Path(dir_okay=False, path_type=Path),
     default=None,
-    help="TOML file naming grids of an imported model (lab = \"grid:2001\", with kinds).",
+    help='TOML file naming grids of an imported model (lab = "grid:2001", with kinds).',
 )
 @click.option(
     "--sources",

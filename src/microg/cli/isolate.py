@@ -115,7 +115,7 @@ def tune(
     """Optimal absorber (k, zeta) for mass ratio MU, numerically, with the closed form beside it."""
     from microg.isolation import den_hartog, h2_closed_form, tune_absorber
 
-    res = tune_absorber(mu, band, criterion, zeta=zeta)  # type: ignore[arg-type]
+    res = tune_absorber(mu, band, criterion, zeta=zeta)
     if as_json:
         click.echo(dumps(res.contract()))
         return
