@@ -163,3 +163,14 @@ def test_plot_leaves_the_backend_alone() -> None:
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip().splitlines()[-1] == "svg"
+
+
+def test_the_package_declares_its_types():
+    # PEP 561: a py.typed marker shipped as package data (mypy runs with
+    # disallow_untyped_defs on src/, so every function is annotated)
+    import tomllib
+
+    assert (ROOT / "src" / "microg" / "py.typed").is_file()
+    conf = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))
+    assert "py.typed" in conf["tool"]["setuptools"]["package-data"]["microg"]
+    assert conf["tool"]["mypy"]["disallow_untyped_defs"] is True

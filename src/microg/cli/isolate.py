@@ -7,6 +7,7 @@ The command computes nothing itself; it parses options (units at the boundary), 
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import click
 import numpy as np
@@ -20,7 +21,7 @@ __all__ = ["isolate"]
 _LBF_PER_N = 1.0 / LBF
 
 
-def _nonneg_range(ctx: click.Context, param: click.Parameter, value):
+def _nonneg_range(ctx: click.Context, param: click.Parameter, value: Any) -> Any:
     if value is not None and value[0] < 0:
         raise click.BadParameter(
             f"need START >= 0 (r^2 is a square), got {value[0]:g}:{value[1]:g}:{value[2]}"

@@ -7,6 +7,7 @@ physical limits of :data:`microg.units.LIMITS`.
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import click
 
@@ -44,7 +45,7 @@ class QuantityType(click.ParamType):
     def get_metavar(self, param: click.Parameter, ctx: click.Context | None = None) -> str:
         return "Q" if self.default_unit is None else f"Q[{self.default_unit}]"
 
-    def convert(self, value, param, ctx):
+    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
         if isinstance(value, float):
             return value
         try:
@@ -80,7 +81,7 @@ class MassOrWeightType(click.ParamType):
     def get_metavar(self, param: click.Parameter, ctx: click.Context | None = None) -> str:
         return f"Q[{self.default_unit}]"
 
-    def convert(self, value, param, ctx):
+    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
         if isinstance(value, float):
             return value
         errors = []
@@ -119,7 +120,7 @@ class PositiveFloat(click.ParamType):
         self.minimum = minimum
         self.strict = strict
 
-    def convert(self, value, param, ctx):
+    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
         try:
             x = float(value)
         except (TypeError, ValueError):
@@ -141,7 +142,7 @@ class RangeType(click.ParamType):
     def __init__(self, max_points: int = 1_000_000):
         self.max_points = max_points
 
-    def convert(self, value, param, ctx):
+    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
         if isinstance(value, tuple):
             return value
         parts = str(value).split(":")
@@ -169,7 +170,7 @@ class BandType(click.ParamType):
 
     name = "LO:HI"
 
-    def convert(self, value, param, ctx):
+    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
         if isinstance(value, tuple):
             return value
         parts = str(value).split(":")

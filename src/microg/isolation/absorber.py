@@ -23,6 +23,7 @@ or the band-limited H2 integral, with a coarse global grid guarding a Nelder-Mea
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Literal
 
@@ -318,7 +319,7 @@ def h2_closed_form(mu: float) -> AbsorberTuning:
 
 def _objective(
     mu: float, band: tuple[float, float] | None, criterion: str, zeta_fixed: float | None
-):
+) -> Callable[[NDArray[np.float64]], float]:
     def fun(x: NDArray[np.float64]) -> float:
         f = math.exp(x[0])
         zeta = zeta_fixed if zeta_fixed is not None else math.exp(x[1])

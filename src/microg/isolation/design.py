@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from microg.errors import InputError
-from microg.isolation.absorber import tune_absorber
+from microg.isolation.absorber import AbsorberTuning, tune_absorber
 from microg.isolation.transmissibility import (
     accel_magnification,
     accel_magnification_no_absorber,
@@ -161,7 +161,7 @@ def design_mount(
         )
     ratio = hi / lo
 
-    def tuned(r_lo: float):
+    def tuned(r_lo: float) -> AbsorberTuning:
         return tune_absorber(mu, (r_lo, r_lo * ratio), "peak", zeta=zeta, xtol=1e-6)
 
     # coarse scan of r_lo from the no-absorber value downwards; keep the last feasible point
