@@ -170,7 +170,7 @@ def test_the_package_declares_its_types():
     # disallow_untyped_defs on src/, so every function is annotated)
     import tomllib
 
-    assert (ROOT / "src" / "microg" / "py.typed").is_file()
-    conf = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))
+    assert (SRC / "py.typed").is_file()
+    conf = tomllib.loads((SRC.parents[1] / "pyproject.toml").read_text(encoding="utf-8"))
     assert "py.typed" in conf["tool"]["setuptools"]["package-data"]["microg"]
     assert conf["tool"]["mypy"]["disallow_untyped_defs"] is True
