@@ -58,13 +58,16 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from datetime import datetime
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from microg.environment.metrics import MAX_SAMPLES
 from microg.errors import InputError
 from microg.units import G0, parse_quantity
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 __all__ = [
     "MAX_HEADER_BYTES",
@@ -130,6 +133,20 @@ class PadHeader:
     data_file: str | None
     fields: dict[str, str] = field(default_factory=dict)
 
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready header (SI values; the other fields as text)."""
+        return {
+            "path": self.path,
+            "data_type": self.data_type,
+            "sensor": self.sensor,
+            "sample_rate_hz": self.sample_rate_hz,
+            "cutoff_hz": self.cutoff_hz,
+            "time_zero": self.time_zero,
+            "data_format": self.data_format,
+            "data_file": self.data_file,
+            "fields": dict(self.fields),
+        }
+
 
 @dataclass(frozen=True)
 class MeasuredRecord:
@@ -187,6 +204,36 @@ class MeasuredRecord:
             "metadata": dict(self.metadata),
             "warnings": list(self.warnings),
         }
+
+    def to_xarray(self) -> Any:
+        """The samples as an ``xarray.DataArray`` ``accel_mps2`` (dims ``axis``, ``time``;
+        m/s^2, times in s), the header in the attributes."""
+        import xarray as xr
+
+        return xr.DataArray(
+            self.accel,
+            dims=("axis", "time"),
+            coords={"axis": list(self.axes), "time": ("time", self.timepts, {"units": "s"})},
+            name="accel_mps2",
+            attrs={
+                "units": "m/s^2",
+                "long_name": "measured acceleration",
+                "sensor": self.sensor or "",
+                "path": self.path,
+                "format": self.format,
+                "sample_rate_hz": self.sample_rate_hz,
+                **({} if self.cutoff_hz is None else {"cutoff_hz": self.cutoff_hz}),
+                **({} if self.start is None else {"start": self.start}),
+            },
+        )
+
+    def plot(self, *, title: str = "") -> Figure:
+        """The record against time, micro-g (``plotting.environment.plot_time_history``)."""
+        from microg.plotting.environment import plot_time_history
+
+        return plot_time_history(
+            self.timepts, self.accel, axes=self.axes, title=title or f"Acceleration at {self.key}"
+        )
 
 
 # ------------------------------------------------------------------------------- PAD files

@@ -97,6 +97,25 @@ def _numbers(a: np.ndarray) -> list[float | str | None]:
     return [json_number(v) for v in np.ravel(a)]
 
 
+def axis_names(n: int, axes: tuple[str, ...] | None = None) -> tuple[str, ...]:
+    """Names of ``n`` axes: ``axes`` when given (checked), ``x, y, z`` for 3, else ``a0, a1``."""
+    if axes is not None:
+        if len(axes) != n:
+            raise InputError(f"{len(axes)} axis names for {n} axes", where="axes")
+        return tuple(axes)
+    return ("x", "y", "z")[:n] if n <= 3 else tuple(f"a{i}" for i in range(n))
+
+
+def _per_axis(axes: tuple[str, ...], a: np.ndarray) -> dict[str, list[float | str | None]]:
+    return {name: _numbers(row) for name, row in zip(axes, np.atleast_2d(a), strict=True)}
+
+
+def _dataset(data: dict[str, Any], coords: dict[str, Any], attrs: dict[str, Any]) -> Any:
+    import xarray as xr
+
+    return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
 @dataclass(frozen=True)
 class Spectrum:
     """One-sided PSD of each axis.
@@ -123,6 +142,49 @@ class Spectrum:
         """The record length, s."""
         return float(self.record_s) if self.record_s is not None else 1.0 / self.df_hz
 
+    @property
+    def psd_g2_per_hz(self) -> np.ndarray:
+        """The PSD in g^2/Hz, (naxes, nf)."""
+        return self.psd / G0**2
+
+    def to_dict(self, axes: tuple[str, ...] | None = None) -> dict[str, Any]:
+        """JSON-ready spectrum: bins (Hz) and the PSD per axis, g^2/Hz."""
+        ax = axis_names(self.psd.shape[0], axes)
+        return {
+            "method": self.method,
+            "df_hz": self.df_hz,
+            "nyquist_hz": self.nyquist_hz,
+            "duration_s": self.duration_s,
+            "freq_hz": _numbers(self.freq_hz),
+            "psd_g2_per_hz_axis": _per_axis(ax, self.psd_g2_per_hz),
+        }
+
+    def to_xarray(self, axes: tuple[str, ...] | None = None) -> Any:
+        """The PSD as an ``xarray.Dataset``: ``psd_g2_per_hz`` on dims ``axis``, ``freq_hz``."""
+        ax = axis_names(self.psd.shape[0], axes)
+        return _dataset(
+            {
+                "psd_g2_per_hz": (
+                    ("axis", "freq_hz"),
+                    self.psd_g2_per_hz,
+                    {"units": "g^2/Hz", "long_name": "one-sided PSD", "method": self.method},
+                )
+            },
+            {"axis": list(ax), "freq_hz": ("freq_hz", self.freq_hz, {"units": "Hz"})},
+            {
+                "method": self.method,
+                "df_hz": self.df_hz,
+                "nyquist_hz": self.nyquist_hz,
+                "duration_s": self.duration_s,
+            },
+        )
+
+    def plot(self, axes: tuple[str, ...] | None = None) -> Figure:
+        """The PSD, g^2/Hz, log-log (:func:`microg.plotting.environment.plot_psd`)."""
+        from microg.plotting.environment import plot_psd
+
+        return plot_psd(self, axes=axis_names(self.psd.shape[0], axes))
+
 
 @dataclass(frozen=True)
 class BandRMS:
@@ -144,6 +206,35 @@ class BandRMS:
     resolved: np.ndarray
     n_bins: np.ndarray = field(default_factory=lambda: np.zeros(0))
     reasons: tuple[str, ...] = ()
+
+    @property
+    def rms_g(self) -> np.ndarray:
+        """Band RMS in g, (naxes, nb)."""
+        return self.rms / G0
+
+    def to_dict(self, axes: tuple[str, ...] | None = None) -> dict[str, Any]:
+        """JSON-ready band RMS: the bands (Hz), band RMS per axis (g), resolution per band."""
+        ax = axis_names(self.rms.shape[0], axes)
+        return {
+            **self.bands.to_dict(),
+            "rms_g_axis": _per_axis(ax, self.rms_g),
+            "coverage": _numbers(self.coverage),
+            "n_bins": _numbers(self.n_bins),
+            "resolved": [bool(v) for v in self.resolved],
+            "reasons": list(self.reasons),
+        }
+
+    def to_xarray(self, axes: tuple[str, ...] | None = None) -> Any:
+        """Band RMS as an ``xarray.Dataset``: dims ``axis``, ``center_hz``; units in attrs."""
+        ax = axis_names(self.rms.shape[0], axes)
+        ds = self.bands.to_xarray()
+        nb = self.bands.center_hz.size
+        ds["rms_g"] = (("axis", "center_hz"), self.rms_g, {"units": "g", "long_name": "band RMS"})
+        ds["coverage"] = ("center_hz", self.coverage, {"units": "1"})
+        n_bins = self.n_bins if self.n_bins.size == nb else np.full(nb, np.nan)
+        ds["n_bins"] = ("center_hz", n_bins, {"units": "1"})
+        ds["resolved"] = ("center_hz", np.asarray(self.resolved, np.int8), {"units": "1"})
+        return ds.assign_coords(axis=list(ax))
 
 
 @dataclass(frozen=True)
@@ -181,6 +272,93 @@ class ThirdOctave:
         """(nb,) the bands that enter the verdict (resolved)."""
         return np.asarray(self.resolved, bool)
 
+    @property
+    def unresolved_bands(self) -> list[dict[str, Any]]:
+        """The bands left out of the verdict: centre, edges and why."""
+        return [
+            {
+                "center_hz": float(self.center_hz[i]),
+                "lower_hz": float(self.lower_hz[i]),
+                "upper_hz": float(self.upper_hz[i]),
+                "reason": self.reasons[i] if i < len(self.reasons) else "unresolved",
+            }
+            for i in np.nonzero(~self.judged)[0]
+        ]
+
+    @property
+    def verdict_range_hz(self) -> tuple[float, float] | None:
+        """(lowest lower edge, highest upper edge) of the judged bands, Hz; None if none."""
+        j = self.judged
+        if not np.any(j):
+            return None
+        return float(self.lower_hz[j].min()), float(self.upper_hz[j].max())
+
+    def to_dict(self, axes: tuple[str, ...] | None = None) -> dict[str, Any]:
+        """JSON-ready bands (the ``third_octave`` block of :meth:`Assessment.to_dict`).
+
+        ``rms_g`` and ``margin`` are the worst over the axes; ``*_axis`` per axis; an infinite
+        margin is ``"inf"``.
+        """
+        ax = axis_names(self.rms_g.shape[0], axes)
+        vr = self.verdict_range_hz
+        return {
+            "center_hz": _numbers(self.center_hz),
+            "lower_hz": _numbers(self.lower_hz),
+            "upper_hz": _numbers(self.upper_hz),
+            "rms_g": _numbers(self.worst_rms_g),
+            "limit_g": _numbers(self.limit_g),
+            "margin": _numbers(self.margin.min(axis=0) if self.margin.size else self.margin),
+            "rms_g_axis": _per_axis(ax, self.rms_g),
+            "margin_axis": _per_axis(ax, self.margin),
+            "rss_rms_g": _numbers(self.rss_rms_g),
+            "resolved": [bool(v) for v in self.resolved],
+            "n_bins": _numbers(self.n_bins),
+            "coverage": _numbers(self.coverage),
+            "unresolved_bands": self.unresolved_bands,
+            "unresolved_exceeding_hz": _numbers(
+                self.center_hz[~self.judged & np.any(self.rms_g > self.limit_g, axis=0)]
+            ),
+            "verdict_bands_hz": _numbers(self.center_hz[self.judged]),
+            "verdict_range_hz": None if vr is None else list(vr),
+        }
+
+    def to_xarray(self, axes: tuple[str, ...] | None = None) -> Any:
+        """Band RMS, limits and margins as an ``xarray.Dataset`` (dims ``axis``, ``center_hz``)."""
+        ax = axis_names(self.rms_g.shape[0], axes)
+        nb = self.center_hz.size
+        return _dataset(
+            {
+                "rms_g": (
+                    ("axis", "center_hz"),
+                    self.rms_g,
+                    {"units": "g", "long_name": "band RMS"},
+                ),
+                "margin": (("axis", "center_hz"), self.margin, {"units": "1"}),
+                "limit_g": ("center_hz", self.limit_g, {"units": "g"}),
+                "rss_rms_g": ("center_hz", self.rss_rms_g, {"units": "g"}),
+                "resolved": ("center_hz", np.asarray(self.resolved, np.int8), {"units": "1"}),
+                "coverage": ("center_hz", self.coverage, {"units": "1"}),
+                "n_bins": (
+                    "center_hz",
+                    self.n_bins if self.n_bins.size == nb else np.full(nb, np.nan),
+                    {"units": "1"},
+                ),
+            },
+            {
+                "axis": list(ax),
+                "center_hz": ("center_hz", self.center_hz, {"units": "Hz"}),
+                "lower_hz": ("center_hz", self.lower_hz, {"units": "Hz"}),
+                "upper_hz": ("center_hz", self.upper_hz, {"units": "Hz"}),
+            },
+            {},
+        )
+
+    def plot(self, axes: tuple[str, ...] | None = None, *, title: str = "") -> Figure:
+        """Band RMS per axis against the limit steps (``plotting.environment.plot_bands``)."""
+        from microg.plotting.environment import plot_bands
+
+        return plot_bands(self, axes=axis_names(self.rms_g.shape[0], axes), title=title)
+
 
 @dataclass(frozen=True)
 class IntegratedAcceleration:
@@ -200,6 +378,51 @@ class IntegratedAcceleration:
     delta_v: np.ndarray
     max_mps: np.ndarray
     max_magnitude_mps: float
+
+    #: what the integral is (in :meth:`to_dict` and :meth:`to_xarray`)
+    DEFINITION = (
+        "max over windows starting at every sample of |integral of the raw acceleration "
+        "over window_s| (microg, conservative)"
+    )
+
+    def to_dict(self, axes: tuple[str, ...] | None = None) -> dict[str, Any]:
+        """JSON-ready summary: the window and the largest integrals, m/s (no per-window rows;
+        those are in :meth:`to_xarray`)."""
+        ax = axis_names(self.delta_v.shape[0], axes)
+        return {
+            "definition": self.DEFINITION,
+            "window_s": self.window_s,
+            "n_windows": int(self.t_start.size),
+            "max_mps_axis": dict(zip(ax, _numbers(self.max_mps), strict=True)),
+            "max_magnitude_mps": json_number(self.max_magnitude_mps),
+        }
+
+    def to_xarray(self, axes: tuple[str, ...] | None = None) -> Any:
+        """The integral of each window as an ``xarray.Dataset``: ``delta_v_mps`` on dims
+        ``axis``, ``t_start_s``."""
+        ax = axis_names(self.delta_v.shape[0], axes)
+        return _dataset(
+            {
+                "delta_v_mps": (
+                    ("axis", "t_start_s"),
+                    self.delta_v,
+                    {"units": "m/s", "long_name": "integral of the acceleration"},
+                ),
+                "max_mps": ("axis", self.max_mps, {"units": "m/s"}),
+            },
+            {"axis": list(ax), "t_start_s": ("t_start_s", self.t_start, {"units": "s"})},
+            {
+                "definition": self.DEFINITION,
+                "window_s": self.window_s,
+                "max_magnitude_mps": self.max_magnitude_mps,
+            },
+        )
+
+    def plot(self, axes: tuple[str, ...] | None = None, *, title: str = "") -> Figure:
+        """Each window's integral against its start (``plotting.environment.plot_integrated``)."""
+        from microg.plotting.environment import plot_integrated
+
+        return plot_integrated(self, axes=axis_names(self.delta_v.shape[0], axes), title=title)
 
 
 @dataclass(frozen=True)
@@ -228,6 +451,52 @@ class IntegratedBlocks:
         """Complete blocks in the record."""
         return int(self.t_start.size)
 
+    #: what the integral is (in :meth:`to_dict` and :meth:`to_xarray`)
+    DEFINITION = (
+        "record demeaned, consecutive blocks of block_samples = ceil(window_s / dt) samples, "
+        "trapezoidal integral of each (NASA PIMS file_trapz)"
+    )
+
+    def to_dict(self, axes: tuple[str, ...] | None = None) -> dict[str, Any]:
+        """JSON-ready summary: the window and the largest integrals, m/s (no per-window rows;
+        those are in :meth:`to_xarray`)."""
+        ax = axis_names(self.delta_v.shape[0], axes)
+        return {
+            "definition": self.DEFINITION,
+            "window_s": self.window_s,
+            "block_samples": self.block_samples,
+            "n_windows": int(self.t_start.size),
+            "max_mps_axis": dict(zip(ax, _numbers(self.max_mps), strict=True)),
+            "max_magnitude_mps": json_number(self.max_magnitude_mps),
+        }
+
+    def to_xarray(self, axes: tuple[str, ...] | None = None) -> Any:
+        """The integral of each window as an ``xarray.Dataset``: ``delta_v_mps`` on dims
+        ``axis``, ``t_start_s``."""
+        ax = axis_names(self.delta_v.shape[0], axes)
+        return _dataset(
+            {
+                "delta_v_mps": (
+                    ("axis", "t_start_s"),
+                    self.delta_v,
+                    {"units": "m/s", "long_name": "integral of the acceleration"},
+                ),
+                "max_mps": ("axis", self.max_mps, {"units": "m/s"}),
+            },
+            {"axis": list(ax), "t_start_s": ("t_start_s", self.t_start, {"units": "s"})},
+            {
+                "definition": self.DEFINITION,
+                "window_s": self.window_s,
+                "max_magnitude_mps": self.max_magnitude_mps,
+            },
+        )
+
+    def plot(self, axes: tuple[str, ...] | None = None, *, title: str = "") -> Figure:
+        """Each window's integral against its start (``plotting.environment.plot_integrated``)."""
+        from microg.plotting.environment import plot_integrated
+
+        return plot_integrated(self, axes=axis_names(self.delta_v.shape[0], axes), title=title)
+
 
 @dataclass(frozen=True)
 class WorstBand:
@@ -240,6 +509,18 @@ class WorstBand:
     margin: float
     lower_hz: float = float("nan")
     upper_hz: float = float("nan")
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready band (an infinite margin is ``"inf"``, an unknown edge None)."""
+        return {
+            "center_hz": self.center_hz,
+            "lower_hz": json_number(self.lower_hz),
+            "upper_hz": json_number(self.upper_hz),
+            "axis": self.axis,
+            "rms_g": self.rms_g,
+            "limit_g": self.limit_g,
+            "margin": json_number(self.margin),
+        }
 
 
 @dataclass(frozen=True)
@@ -310,25 +591,12 @@ class Assessment:
     @property
     def verdict_range_hz(self) -> tuple[float, float] | None:
         """(lowest lower edge, highest upper edge) of the judged bands, Hz; None if none."""
-        to = self.third_octave
-        j = to.judged
-        if not np.any(j):
-            return None
-        return float(to.lower_hz[j].min()), float(to.upper_hz[j].max())
+        return self.third_octave.verdict_range_hz
 
     @property
     def unresolved_bands(self) -> list[dict[str, Any]]:
         """The bands left out of the verdict: centre, edges and why."""
-        to = self.third_octave
-        return [
-            {
-                "center_hz": float(to.center_hz[i]),
-                "lower_hz": float(to.lower_hz[i]),
-                "upper_hz": float(to.upper_hz[i]),
-                "reason": to.reasons[i] if i < len(to.reasons) else "unresolved",
-            }
-            for i in np.nonzero(~to.judged)[0]
-        ]
+        return self.third_octave.unresolved_bands
 
     # ---------------------------------------------------------------------------- outputs
 
@@ -343,7 +611,6 @@ class Assessment:
         def per_axis(a: np.ndarray) -> dict[str, float | str | None]:
             return dict(zip(ax, _numbers(a), strict=True))
 
-        vr = self.verdict_range_hz
         sl = self.integrated_sliding
         out: dict[str, Any] = {
             "peak_accel_g": self.peak_accel_g,
@@ -362,44 +629,14 @@ class Assessment:
                 "cutoff_hz": self.cutoff_hz,
                 "demeaned": True,
             },
-            "third_octave": {
-                "center_hz": _numbers(to.center_hz),
-                "lower_hz": _numbers(to.lower_hz),
-                "upper_hz": _numbers(to.upper_hz),
-                "rms_g": _numbers(to.worst_rms_g),
-                "limit_g": _numbers(to.limit_g),
-                "margin": _numbers(to.margin.min(axis=0) if to.margin.size else to.margin),
-                "rms_g_axis": {a: _numbers(r) for a, r in zip(ax, to.rms_g, strict=True)},
-                "margin_axis": {a: _numbers(m) for a, m in zip(ax, to.margin, strict=True)},
-                "rss_rms_g": _numbers(to.rss_rms_g),
-                "resolved": [bool(v) for v in to.resolved],
-                "n_bins": _numbers(to.n_bins),
-                "coverage": _numbers(to.coverage),
-                "unresolved_bands": self.unresolved_bands,
-                "unresolved_exceeding_hz": _numbers(
-                    to.center_hz[~to.judged & np.any(to.rms_g > to.limit_g, axis=0)]
-                ),
-                "verdict_bands_hz": _numbers(self.verdict_bands_hz),
-                "verdict_range_hz": None if vr is None else list(vr),
-            },
+            "third_octave": to.to_dict(ax),
             "requirement": self.requirement,
             "requirement_source": self.requirement_source,
             "complies": bool(self.complies),
             "peak_limit_g": self.peak_limit_g,
-            "worst_band": None
-            if self.worst_band is None
-            else {
-                "center_hz": self.worst_band.center_hz,
-                "lower_hz": self.worst_band.lower_hz,
-                "upper_hz": self.worst_band.upper_hz,
-                "axis": self.worst_band.axis,
-                "rms_g": self.worst_band.rms_g,
-                "limit_g": self.worst_band.limit_g,
-                "margin": json_number(self.worst_band.margin),
-            },
+            "worst_band": None if self.worst_band is None else self.worst_band.to_dict(),
             "integrated_accel_sliding": {
-                "definition": "max over windows starting at every sample of |integral of the "
-                "raw acceleration over window_s| (microg, conservative)",
+                "definition": sl.DEFINITION,
                 "window_s": sl.window_s,
                 "max_mps_axis": per_axis(sl.max_mps),
                 "max_magnitude_mps": sl.max_magnitude_mps,
@@ -413,9 +650,7 @@ class Assessment:
         pb = self.integrated_pims
         if pb is not None:
             out["integrated_accel_pims"] = {
-                "definition": "record demeaned, consecutive blocks of block_samples = "
-                "ceil(window_s / dt) samples, trapezoidal integral of each (NASA PIMS "
-                "file_trapz)",
+                "definition": pb.DEFINITION,
                 "window_s": pb.window_s,
                 "block_samples": pb.block_samples,
                 "n_blocks": pb.n_blocks,

@@ -21,10 +21,14 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from functools import lru_cache
 from importlib import resources
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from microg.errors import InputError
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 __all__ = [
     "BandTable",
@@ -47,6 +51,28 @@ class BandTable:
     lower_hz: np.ndarray
     upper_hz: np.ndarray
 
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready bands: centres and edges, Hz."""
+        return {
+            "center_hz": [float(v) for v in self.center_hz],
+            "lower_hz": [float(v) for v in self.lower_hz],
+            "upper_hz": [float(v) for v in self.upper_hz],
+        }
+
+    def to_xarray(self) -> Any:
+        """The bands as an ``xarray.Dataset``: dim ``center_hz``, edges as coordinates, and
+        ``width_hz`` (upper - lower) as the data variable."""
+        import xarray as xr
+
+        return xr.Dataset(
+            {"width_hz": ("center_hz", self.upper_hz - self.lower_hz, {"units": "Hz"})},
+            coords={
+                "center_hz": ("center_hz", self.center_hz, {"units": "Hz"}),
+                "lower_hz": ("center_hz", self.lower_hz, {"units": "Hz"}),
+                "upper_hz": ("center_hz", self.upper_hz, {"units": "Hz"}),
+            },
+        )
+
 
 @dataclass(frozen=True)
 class Requirement:
@@ -66,6 +92,31 @@ class Requirement:
     limit_g: np.ndarray
     source: str
     peak_limit_g: float | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready requirement: name, source, bands (Hz), limit per band (g), peak limit."""
+        return {
+            "name": self.name,
+            "source": self.source,
+            **self.bands.to_dict(),
+            "limit_g": [float(v) for v in self.limit_g],
+            "peak_limit_g": self.peak_limit_g,
+        }
+
+    def to_xarray(self) -> Any:
+        """The limit per band as an ``xarray.Dataset`` (dim ``center_hz``; units in attrs)."""
+        ds = self.bands.to_xarray()
+        ds["limit_g"] = ("center_hz", np.asarray(self.limit_g, float), {"units": "g"})
+        ds.attrs.update(name=self.name, source=self.source)
+        if self.peak_limit_g is not None:
+            ds.attrs["peak_limit_g"] = self.peak_limit_g
+        return ds
+
+    def plot(self, *, title: str = "") -> Figure:
+        """The limit as steps on the band edges (``plotting.environment.plot_requirement``)."""
+        from microg.plotting.environment import plot_requirement
+
+        return plot_requirement(self, title=title)
 
 
 def third_octave_bands(fmin_hz: float = 0.01, fmax_hz: float = 316.3, base: int = 10) -> BandTable:

@@ -25,13 +25,16 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
 
 from microg.errors import InputError, SolverError
 from microg.isolation.transmissibility import accel_magnification, spring_ratio_from_tuning
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 __all__ = [
     "AbsorberTuning",
@@ -58,6 +61,10 @@ class PeakResult:
 
     peak_Ma: float  # noqa: N815 - the CLI contract name
     r_peak: float
+
+    def to_dict(self) -> dict[str, float]:
+        """JSON-ready ``{"peak_Ma", "r_peak"}`` (both dimensionless)."""
+        return {"peak_Ma": self.peak_Ma, "r_peak": self.r_peak}
 
 
 @dataclass(frozen=True)
@@ -88,6 +95,56 @@ class AbsorberTuning:
     criterion: str
     band: tuple[float, float] | None
     method: str
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready design: every attribute (all dimensionless), ``band`` as a list or None."""
+        return {
+            "mu": self.mu,
+            "k": self.k,
+            "zeta": self.zeta,
+            "f": self.f,
+            "peak_Ma": self.peak_Ma,
+            "r_peak": self.r_peak,
+            "h2": self.h2,
+            "criterion": self.criterion,
+            "band": None if self.band is None else [float(b) for b in self.band],
+            "method": self.method,
+        }
+
+    def to_xarray(self, r: np.ndarray | None = None) -> Any:
+        """``M_a`` (Eq. 4.3 solved) and the package alone over ``r`` as an ``xarray.Dataset``.
+
+        Parameters
+        ----------
+        r : ndarray, optional
+            Frequency ratios ``omega/omega_n`` (default 2,001 from 0 to 3, or to 1.5 times the
+            band's upper end, with ``r_peak``).
+        """
+        import xarray as xr
+
+        from microg.isolation.transmissibility import accel_magnification_no_absorber
+
+        if r is None:
+            top = max(3.0, 1.5 * self.band[1]) if self.band is not None else 3.0
+            r = np.unique(np.r_[np.linspace(0.0, top, 2001), self.r_peak])
+        r = np.asarray(r, float)
+        with np.errstate(divide="ignore"):
+            alone = accel_magnification_no_absorber(r)
+        return xr.Dataset(
+            {
+                "Ma": ("r", accel_magnification(self.k, self.mu, self.zeta, r), {"units": "1"}),
+                "Ma_no_absorber": ("r", alone, {"units": "1"}),
+            },
+            coords={"r": ("r", r, {"units": "1", "long_name": "omega/omega_n"})},
+            attrs={k: v for k, v in self.to_dict().items() if v is not None and k != "band"}
+            | ({} if self.band is None else {"band_r": list(self.band)}),
+        )
+
+    def plot(self) -> Figure:
+        """``M_a`` against ``r``, the band and the peak (``plotting.isolation.plot_absorber``)."""
+        from microg.plotting.isolation import plot_absorber
+
+        return plot_absorber(self)
 
     def contract(self) -> dict[str, float | str]:
         """The CLI contract ``{"k", "zeta", "f", "peak_Ma", "criterion"}``."""

@@ -31,6 +31,8 @@ from microg.errors import InputError
 from microg.units import IN, LBF
 
 if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
     from microg.dynamics.response import PointResponse
     from microg.environment.metrics import Assessment
     from microg.environment.requirements import Requirement
@@ -112,6 +114,53 @@ class IsolationAdvice:
         """Advice placeholder when isolation is not asked for."""
         return cls(point, "not-assessed", note="isolation not assessed")
 
+    def freq_hz(self) -> np.ndarray:
+        """Frequencies for the mounts' curves, Hz: the design's and the screened mount's grids
+        joined (empty when neither exists)."""
+        grids = [m.default_freq_hz() for m in (self.design, self.mount) if m is not None]
+        return np.unique(np.concatenate(grids)) if grids else np.zeros(0)
+
+    def to_xarray(self) -> Any:
+        """Attenuation needed per exceeding band and the mounts' curves, ``xarray.Dataset``.
+
+        Dims ``center_hz`` (exceeding bands: ``attenuation_needed``, and ``required_Ma`` =
+        1 / attenuation) and ``freq_hz`` (``design_Ma``: the report-rule design's ``M_a``;
+        ``mount_transmissibility``: the screened mount's ``|U1/U0|``), all dimensionless.
+        """
+        import xarray as xr
+
+        centers = np.array(sorted(self.attenuation_needed), float)
+        factor = np.array([self.attenuation_needed[c] for c in sorted(self.attenuation_needed)])
+        f = self.freq_hz()
+        data: dict[str, Any] = {
+            "attenuation_needed": ("center_hz", factor, {"units": "1"}),
+            "required_Ma": ("center_hz", 1.0 / factor if factor.size else factor, {"units": "1"}),
+        }
+        if self.design is not None:
+            data["design_Ma"] = ("freq_hz", self.design.magnification(f), {"units": "1"})
+        if self.mount is not None:
+            t = self.mount.transmissibility(f)
+            data["mount_transmissibility"] = ("freq_hz", t, {"units": "1"})
+        return xr.Dataset(
+            data,
+            coords={
+                "center_hz": ("center_hz", centers, {"units": "Hz"}),
+                "freq_hz": ("freq_hz", f, {"units": "Hz"}),
+            },
+            attrs={
+                "point": self.point,
+                "status": self.status,
+                "recommended": int(self.recommended),
+                "verified": self.verified or "",
+            },
+        )
+
+    def plot(self) -> Figure:
+        """Attenuation needed per band against the mounts' curves (``plotting.isolation``)."""
+        from microg.plotting.isolation import plot_isolation_advice
+
+        return plot_isolation_advice(self)
+
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready advice (keys documented in docs/assessment.md)."""
         out: dict[str, Any] = {
@@ -145,16 +194,7 @@ class IsolationAdvice:
             }
         mc = self.mount
         if mc is not None:
-            screened = {
-                "found": bool(mc.found),
-                "k1_N_per_m": mc.k1,
-                "k1_lbf_per_in": mc.k1 * IN / LBF,
-                "zeta1": mc.zeta1,
-                "c1_N_s_per_m": mc.c1,
-                "natural_freq_hz": mc.freq_hz_n,
-                "screen_min_margin": mc.min_margin,
-                "screened": mc.screened,
-            }
+            screened = mc.to_dict()
             out["screened_mount"] = screened
             if self.recommended and self.verified == "screened":
                 out["recommended_mount"] = screened

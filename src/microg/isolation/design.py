@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -20,6 +21,9 @@ from microg.isolation.transmissibility import (
     accel_magnification_no_absorber,
 )
 from microg.units import G0, G0_US, IN, LBF
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 __all__ = [
     "MountDesign",
@@ -100,6 +104,73 @@ class MountDesign:
     m2: float | None = None
     k2: float | None = None
     c: float | None = None
+
+    @property
+    def band_hz(self) -> tuple[float, float]:
+        """The disturbance band, Hz."""
+        return self.omega_band[0] / (2 * math.pi), self.omega_band[1] / (2 * math.pi)
+
+    def magnification(self, freq_hz: np.ndarray) -> np.ndarray:
+        """``M_a`` of this design at support frequencies ``freq_hz`` (Hz), with its absorber."""
+        r = np.asarray(freq_hz, float) / self.freq_hz_n
+        if self.mu is None or self.k is None or self.zeta is None:
+            with np.errstate(divide="ignore"):
+                return accel_magnification_no_absorber(r)
+        return accel_magnification(self.k, self.mu, self.zeta, r)
+
+    def default_freq_hz(self) -> np.ndarray:
+        """801 log-spaced frequencies from f_n / 20 to 5 times the band's top, with the band
+        edges, Hz."""
+        lo, hi = self.band_hz
+        grid = np.geomspace(self.freq_hz_n / 20, max(5 * hi, 20 * self.freq_hz_n), 801)
+        return np.unique(np.r_[grid, lo, hi])
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready design; keys carry units (``k1_N_per_m``, ``sag_1g_m``, ``mass_kg``)."""
+        return {
+            "mass_kg": self.mass,
+            "omega_band": [float(w) for w in self.omega_band],
+            "band_hz": list(self.band_hz),
+            "target_Ma": self.target,
+            "k1_N_per_m": self.k1,
+            "k1_lbf_per_in": self.k1_lbf_per_in,
+            "omega_n": self.omega_n,
+            "natural_freq_hz": self.freq_hz_n,
+            "r_band": [float(r) for r in self.r_band],
+            "achieved_Ma": self.achieved_Ma,
+            "sag_1g_m": self.sag_1g,
+            "mu": self.mu,
+            "absorber_k": self.k,
+            "absorber_zeta": self.zeta,
+            "absorber_f": self.f,
+            "m2_kg": self.m2,
+            "k2_N_per_m": self.k2,
+            "c_N_s_per_m": self.c,
+        }
+
+    def to_xarray(self, freq_hz: np.ndarray | None = None) -> Any:
+        """``M_a`` over support frequency as an ``xarray.Dataset`` (dim ``freq_hz``).
+
+        Parameters
+        ----------
+        freq_hz : ndarray, optional
+            Frequencies, Hz (default :meth:`default_freq_hz`).
+        """
+        import xarray as xr
+
+        f = self.default_freq_hz() if freq_hz is None else np.asarray(freq_hz, float)
+        return xr.Dataset(
+            {"Ma": ("freq_hz", self.magnification(f), {"units": "1", "long_name": "M_a"})},
+            coords={"freq_hz": ("freq_hz", f, {"units": "Hz"})},
+            attrs={k: v for k, v in self.to_dict().items() if v is not None}
+            | {"omega_band_units": "rad/s", "omega_n_units": "rad/s"},
+        )
+
+    def plot(self) -> Figure:
+        """``M_a`` against frequency, the band and the target (``plotting.isolation``)."""
+        from microg.plotting.isolation import plot_mount_design
+
+        return plot_mount_design(self)
 
 
 def _validate_design(mass: float, band: tuple[float, float], target: float) -> None:
@@ -269,6 +340,18 @@ class ClaimCheck:
     values: dict[str, float] = field(default_factory=dict)
     note: str = ""
 
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready check (``values`` keep their unit-suffixed names)."""
+        return {
+            "id": self.id,
+            "statement": self.statement,
+            "holds": bool(self.holds),
+            "printed": self.printed,
+            "recomputed": self.recomputed,
+            "values": {k: float(v) for k, v in self.values.items()},
+            "note": self.note,
+        }
+
 
 @dataclass(frozen=True)
 class Section42Claims:
@@ -281,6 +364,18 @@ class Section42Claims:
     zeta: float
     mu_max: float
     checks: tuple[ClaimCheck, ...]
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready inputs (``omega*`` in rad/s) and every check."""
+        return {
+            "weight_lbf": self.weight_lbf,
+            "omega": self.omega,
+            "omega_fundamental": self.omega_fundamental,
+            "omega_lowest_bending": self.omega_lowest_bending,
+            "zeta": self.zeta,
+            "mu_max": self.mu_max,
+            "checks": [c.to_dict() for c in self.checks],
+        }
 
     def by_id(self, claim_id: str) -> ClaimCheck:
         """The check labelled ``claim_id``."""

@@ -13,12 +13,16 @@ verifies the choice with the exact time-domain response
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from microg.environment.metrics import Spectrum, band_rms
+from microg.environment.metrics import Spectrum, band_rms, json_number
 from microg.environment.requirements import Requirement
-from microg.units import G0
+from microg.units import G0, IN, LBF
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 __all__ = ["mount_transmissibility", "MountChoice", "search_mount"]
 
@@ -75,6 +79,51 @@ class MountChoice:
     min_margin: float
     freq_hz_n: float
     screened: int
+
+    @property
+    def mass_kg(self) -> float:
+        """Package mass ``k1 / (2 pi f_n)^2``, kg."""
+        return self.k1 / (2 * np.pi * self.freq_hz_n) ** 2
+
+    def transmissibility(self, freq_hz: np.ndarray) -> np.ndarray:
+        """``|U1/U0|`` of this mount at support frequencies ``freq_hz`` (Hz)."""
+        w = 2 * np.pi * np.asarray(freq_hz, float)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.abs(mount_transmissibility(self.k1, self.c1, self.mass_kg, w))
+
+    def default_freq_hz(self) -> np.ndarray:
+        """801 log-spaced frequencies from f_n / 20 to 50 f_n, Hz."""
+        return np.geomspace(self.freq_hz_n / 20, 50 * self.freq_hz_n, 801)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready choice; keys carry units (the ``screened_mount`` of the advice)."""
+        return {
+            "found": bool(self.found),
+            "k1_N_per_m": self.k1,
+            "k1_lbf_per_in": self.k1 * IN / LBF,
+            "zeta1": self.zeta1,
+            "c1_N_s_per_m": self.c1,
+            "natural_freq_hz": self.freq_hz_n,
+            "screen_min_margin": json_number(self.min_margin),
+            "screened": self.screened,
+        }
+
+    def to_xarray(self, freq_hz: np.ndarray | None = None) -> Any:
+        """``|U1/U0|`` over support frequency as an ``xarray.Dataset`` (dim ``freq_hz``)."""
+        import xarray as xr
+
+        f = self.default_freq_hz() if freq_hz is None else np.asarray(freq_hz, float)
+        return xr.Dataset(
+            {"transmissibility": ("freq_hz", self.transmissibility(f), {"units": "1"})},
+            coords={"freq_hz": ("freq_hz", f, {"units": "Hz"})},
+            attrs=self.to_dict() | {"found": int(self.found), "mass_kg": self.mass_kg},
+        )
+
+    def plot(self) -> Figure:
+        """``|U1/U0|`` against frequency (``plotting.isolation.plot_mount_choice``)."""
+        from microg.plotting.isolation import plot_mount_choice
+
+        return plot_mount_choice(self)
 
 
 def search_mount(

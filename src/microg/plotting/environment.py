@@ -7,7 +7,7 @@ the band edges (each band's limit from its lower to its upper edge), as PIMS dra
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from matplotlib.figure import Figure
@@ -22,11 +22,18 @@ from microg.environment.metrics import (
 from microg.plotting.common import envelope, finish, new_figure
 from microg.units import G0
 
+if TYPE_CHECKING:
+    from microg.environment.metrics import IntegratedAcceleration, IntegratedBlocks
+    from microg.environment.requirements import Requirement
+
 __all__ = [
     "limit_steps",
     "plot_time_history",
     "plot_psd",
+    "plot_bands",
     "plot_third_octave",
+    "plot_requirement",
+    "plot_integrated",
     "plot_integrated_acceleration",
     "plot_overlay",
 ]
@@ -102,26 +109,95 @@ def _bands_on(ax: Any, to: ThirdOctave, axes: tuple[str, ...], style: str, label
             )
 
 
-def plot_third_octave(assessment: Assessment, *, title: str = "") -> Figure:
-    """1/3-octave band RMS per axis against the requirement's steps (micro-g); returns a Figure.
-
-    Filled markers: bands the verdict judges; hollow: bands the record does not resolve (left
-    out of the verdict); shaded: the range the verdict covers.
-    """
-    to = assessment.third_octave
-    fig, ax = _figure(title or f"1/3-octave band RMS vs {assessment.requirement}")
-    _bands_on(ax, to, assessment.axes, "o-", "")
-    x, y = limit_steps(to.lower_hz, to.upper_hz, to.limit_g * 1e6)
-    ax.plot(x, y, color="k", lw=1.5, label="limit")
-    vr = assessment.verdict_range_hz
-    if vr is not None:
-        ax.axvspan(vr[0], vr[1], color="0.85", alpha=0.4, lw=0, label="judged bands")
+def _band_axes(ax: Any) -> None:
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel("frequency [Hz] (markers at band centres, limit on band edges)")
     ax.set_ylabel("band RMS [micro-g]")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
+
+
+def _limit_on(ax: Any, lower_hz: np.ndarray, upper_hz: np.ndarray, limit_g: np.ndarray) -> None:
+    x, y = limit_steps(lower_hz, upper_hz, np.asarray(limit_g, float) * 1e6)
+    ax.plot(x, y, color="k", lw=1.5, label="limit")
+
+
+def plot_bands(
+    to: ThirdOctave,
+    *,
+    axes: tuple[str, ...] = ("x", "y", "z"),
+    title: str = "",
+    verdict_range_hz: tuple[float, float] | None = None,
+) -> Figure:
+    """1/3-octave band RMS per axis against the limit's steps (micro-g); returns a Figure.
+
+    Parameters
+    ----------
+    to : ThirdOctave
+        Band RMS (g), limits (g), resolution.
+    axes : tuple of str
+        Names of the rows of ``to.rms_g``.
+    title : str
+        Figure title (default: a generic one).
+    verdict_range_hz : (float, float), optional
+        The frequency range the verdict covers, Hz, shaded (default: the judged bands').
+
+    Filled markers: bands the verdict judges; hollow: bands the record does not resolve (left
+    out of the verdict).
+    """
+    fig, ax = _figure(title or "1/3-octave band RMS")
+    _bands_on(ax, to, axes, "o-", "")
+    _limit_on(ax, to.lower_hz, to.upper_hz, to.limit_g)
+    vr = verdict_range_hz if verdict_range_hz is not None else to.verdict_range_hz
+    if vr is not None:
+        ax.axvspan(vr[0], vr[1], color="0.85", alpha=0.4, lw=0, label="judged bands")
+    _band_axes(ax)
+    return finish(fig)
+
+
+def plot_third_octave(assessment: Assessment, *, title: str = "") -> Figure:
+    """1/3-octave band RMS per axis against the requirement's steps (micro-g); returns a Figure.
+
+    Filled markers: bands the verdict judges; hollow: bands the record does not resolve (left
+    out of the verdict); shaded: the range the verdict covers.
+    """
+    return plot_bands(
+        assessment.third_octave,
+        axes=assessment.axes,
+        title=title or f"1/3-octave band RMS vs {assessment.requirement}",
+        verdict_range_hz=assessment.verdict_range_hz,
+    )
+
+
+def plot_requirement(req: Requirement, *, title: str = "") -> Figure:
+    """A requirement's band-RMS limit as steps on the band edges (micro-g); returns a Figure."""
+    fig, ax = _figure(title or f"Requirement {req.name}")
+    b = req.bands
+    _limit_on(ax, b.lower_hz, b.upper_hz, req.limit_g)
+    ax.plot(b.center_hz, np.asarray(req.limit_g, float) * 1e6, "o", ms=3, color="k", label="_c")
+    if req.peak_limit_g is not None:
+        ax.axhline(req.peak_limit_g * 1e6, color="crimson", ls="--", lw=1.0, label="peak limit")
+    _band_axes(ax)
+    ax.set_ylabel("band-RMS limit [micro-g]")
+    return finish(fig)
+
+
+def plot_integrated(
+    integ: IntegratedAcceleration | IntegratedBlocks,
+    *,
+    axes: tuple[str, ...] = ("x", "y", "z"),
+    title: str = "",
+) -> Figure:
+    """Each window's (or block's) integral of the acceleration (m/s) against its start, s."""
+    kind = "blocks" if hasattr(integ, "block_samples") else "sliding"
+    fig, ax = _figure(title or f"Integrated acceleration, {kind} {integ.window_s:g}-s windows")
+    for name, row in zip(axes, integ.delta_v, strict=False):
+        ax.plot(*envelope(integ.t_start, row), label=name, lw=0.8)
+    ax.set_xlabel("window start [s]")
+    ax.set_ylabel("integral of acceleration [m/s]")
+    ax.grid(True, alpha=0.3)
+    ax.legend()
     return finish(fig)
 
 
@@ -133,16 +209,10 @@ def plot_integrated_acceleration(
     axes: tuple[str, ...] = ("x", "y", "z"),
     title: str = "",
 ) -> Figure:
-    """Integrated acceleration over sliding windows (m/s) against window start; returns a Figure."""
-    integ = integrated_acceleration(timepts, accel, window_s)
-    fig, ax = _figure(title or f"Integrated acceleration, sliding {integ.window_s:g}-s windows")
-    for name, row in zip(axes, integ.delta_v, strict=False):
-        ax.plot(*envelope(integ.t_start, row), label=name, lw=0.8)
-    ax.set_xlabel("window start [s]")
-    ax.set_ylabel("integral of acceleration [m/s]")
-    ax.grid(True, alpha=0.3)
-    ax.legend()
-    return finish(fig)
+    """Integrated acceleration over sliding windows (m/s) of a record (times s, m/s^2)."""
+    return plot_integrated(
+        integrated_acceleration(timepts, accel, window_s), axes=axes, title=title
+    )
 
 
 def plot_overlay(

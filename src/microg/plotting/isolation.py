@@ -1,9 +1,12 @@
-"""Figure 8 of the report: acceleration magnification factor ``M_a`` against ``r^2``."""
+"""Isolation figures: Figure 8 of the report (``M_a`` against ``r^2``), an absorber's, a mount
+design's and a screened mount's curves, and the isolation advice.  They draw the numbers of the
+result objects' ``to_xarray()``; they compute nothing of their own."""
 
 from __future__ import annotations
 
 import io
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from matplotlib.figure import Figure
@@ -13,8 +16,22 @@ from microg.isolation.transmissibility import (
     accel_magnification,
     accel_magnification_no_absorber,
 )
+from microg.plotting.common import finish, new_figure
 
-__all__ = ["figure8", "write_png_atomic"]
+if TYPE_CHECKING:
+    from microg.isolation.absorber import AbsorberTuning
+    from microg.isolation.advise import IsolationAdvice
+    from microg.isolation.design import MountDesign
+    from microg.isolation.mount import MountChoice
+
+__all__ = [
+    "figure8",
+    "write_png_atomic",
+    "plot_absorber",
+    "plot_mount_design",
+    "plot_mount_choice",
+    "plot_isolation_advice",
+]
 
 
 def write_png_atomic(fig: Figure, path: str | Path, dpi: int = 150) -> Path:
@@ -93,3 +110,98 @@ def figure8(
     if path is not None:
         write_png_atomic(fig, path)
     return fig
+
+
+def _log_axes(ax: Any, xlabel: str, ylabel: str) -> None:
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+
+
+def plot_absorber(tuning: AbsorberTuning) -> Figure:
+    """``M_a`` of a tuned absorber against ``r = omega/omega_n``, the package alone dashed,
+    the design band shaded and the peak marked; returns a Figure."""
+    ds = tuning.to_xarray()
+    r = ds["r"].values
+    fig = new_figure(7.5, 4.2)
+    ax = fig.add_subplot()
+    ax.semilogy(r, ds["Ma"].values, lw=1.3, label=f"absorber (k = {tuning.k:.4g})")
+    ax.semilogy(r, ds["Ma_no_absorber"].values, "k--", lw=0.9, label="no absorber")
+    ax.plot([tuning.r_peak], [tuning.peak_Ma], "o", color="crimson", label="peak")
+    if tuning.band is not None:
+        ax.axvspan(*tuning.band, color="0.85", alpha=0.5, lw=0, label="band")
+    ax.axhline(1.0, color="0.5", lw=0.6)
+    ax.set_ylim(0.05, 50.0)
+    ax.set_xlabel("r = omega/omega_n")
+    ax.set_ylabel("M_a = |U1/U0|")
+    ax.set_title(
+        f"Absorber, mu = {tuning.mu:g}, zeta = {tuning.zeta:.3g} ({tuning.criterion})",
+        fontsize=10,
+    )
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    return finish(fig)
+
+
+def plot_mount_design(design: MountDesign) -> Figure:
+    """A mount design's ``M_a`` against support frequency (Hz), the disturbance band shaded
+    and the target drawn; returns a Figure."""
+    ds = design.to_xarray()
+    fig = new_figure(7.5, 4.2)
+    ax = fig.add_subplot()
+    ax.plot(ds["freq_hz"].values, ds["Ma"].values, lw=1.3, label="M_a")
+    ax.axvspan(*design.band_hz, color="0.85", alpha=0.5, lw=0, label="disturbance band")
+    ax.axhline(design.target, color="crimson", ls="--", lw=1.0, label="target")
+    ax.axvline(design.freq_hz_n, color="0.5", lw=0.6, ls=":", label="natural frequency")
+    ax.set_title(f"Mount k1 = {design.k1:.4g} N/m, f_n = {design.freq_hz_n:.3g} Hz", fontsize=10)
+    _log_axes(ax, "support frequency [Hz]", "M_a = |U1/U0|")
+    return finish(fig)
+
+
+def plot_mount_choice(choice: MountChoice) -> Figure:
+    """A screened spring-damper mount's ``|U1/U0|`` against frequency (Hz); returns a Figure."""
+    ds = choice.to_xarray()
+    fig = new_figure(7.5, 4.2)
+    ax = fig.add_subplot()
+    ax.plot(ds["freq_hz"].values, ds["transmissibility"].values, lw=1.3, label="|U1/U0|")
+    ax.axvline(choice.freq_hz_n, color="0.5", lw=0.6, ls=":", label="natural frequency")
+    ax.axhline(1.0, color="0.5", lw=0.6)
+    state = "complies" if choice.found else "best, does not comply"
+    ax.set_title(
+        f"Screened mount: k1 = {choice.k1:.4g} N/m, zeta1 = {choice.zeta1:g} ({state})",
+        fontsize=10,
+    )
+    _log_axes(ax, "support frequency [Hz]", "transmissibility |U1/U0|")
+    return finish(fig)
+
+
+def plot_isolation_advice(advice: IsolationAdvice) -> Figure:
+    """The largest ``M_a`` each exceeding band allows (1 / attenuation needed) against the
+    report-rule design's ``M_a`` and the screened mount's ``|U1/U0|``; returns a Figure."""
+    ds = advice.to_xarray()
+    fig = new_figure(7.5, 4.2)
+    ax = fig.add_subplot()
+    ax.set_title(f"Isolation at {advice.point}: {advice.status}", fontsize=10)
+    if ds.sizes["center_hz"] == 0 and ds.sizes["freq_hz"] == 0:
+        ax.text(0.5, 0.5, advice.note or advice.status, ha="center", va="center", wrap=True)
+        ax.set_axis_off()
+        return finish(fig)
+    f = ds["freq_hz"].values
+    if "design_Ma" in ds:
+        ax.plot(f, ds["design_Ma"].values, lw=1.2, label="report-rule design M_a")
+    if "mount_transmissibility" in ds:
+        ax.plot(f, ds["mount_transmissibility"].values, lw=1.2, label="screened mount |U1/U0|")
+    if ds.sizes["center_hz"]:
+        ax.plot(
+            ds["center_hz"].values,
+            ds["required_Ma"].values,
+            "v",
+            color="crimson",
+            ms=6,
+            label="largest M_a allowed (1 / attenuation needed)",
+        )
+    _log_axes(ax, "frequency [Hz]", "magnification")
+    return finish(fig)
