@@ -497,26 +497,28 @@ def _table_run(st: _State, k: int, tau: np.ndarray, qs: tuple[int, ...], dest: n
                 )
         if rem:
             tg[:, :, full_blocks * L :] = (lh[:, :, -1, None, :] @ rh[:, :, :rem])[:, :, 0]
-    # stable recomputation of eta, eta' where omega tau < _SERIES_BELOW
+    # stable recomputation of eta, eta' where omega tau < _SERIES_BELOW: only those entries (a
+    # prefix of the run for each mode), gathered flat, so a run starting at a breakpoint costs
+    # about sum_j 0.5 / (omega_j dt) evaluations instead of a (modes x longest prefix) block
     fix = [iq for iq, q in enumerate(qs) if q < 2]
     if fix:
         n_small = np.searchsorted(tau, _SERIES_BELOW / omega, side="left")
-        nmax = int(n_small.max(initial=0))
-        if nmax:
+        total = int(n_small.sum())
+        if total:
             sel = np.flatnonzero(n_small)
-            tt = tau[None, :nmax]
-            g, h, S, R = oscillator_functions(omega[sel, None], zeta[sel, None], tt)
+            cnt = n_small[sel]
+            rows_f = np.repeat(sel, cnt)  # elastic-mode index of each entry
+            starts_f = np.cumsum(cnt) - cnt
+            cols_f = np.arange(total) - np.repeat(starts_f, cnt)  # position in the run
+            g, h, S, R = oscillator_functions(omega[rows_f], zeta[rows_f], tau[cols_f])
             assert R is not None
-            mask = np.arange(nmax)[None, :] < n_small[sel, None]
-            ee, vv, aa = e0[sel, None], v0[sel, None], a0[sel, None]
+            ee, vv, aa = e0[rows_f], v0[rows_f], a0[rows_f]
             stable = (
-                ee * g + vv * h + p0[sel, None] * S + s0[sel, None] * R,
-                vv * g + aa * h + s0[sel, None] * S,
+                ee * g + vv * h + p0[rows_f] * S + s0[rows_f] * R,
+                vv * g + aa * h + s0[rows_f] * S,
             )
-            sub = np.ix_(sel, np.arange(nmax))
             for iq in fix:
-                view = target[iq]
-                view[sub] = np.where(mask, stable[qs[iq]], view[sub])
+                target[iq][rows_f, cols_f] = stable[qs[iq]]
     if not contiguous:
         dest[:, el] = target
 
