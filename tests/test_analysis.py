@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
@@ -389,3 +391,26 @@ def test_three_component_force_is_the_sum_of_its_components(station, tmp_path) -
     assert np.max(np.abs(a - ref)) <= 1e-12 * np.max(np.abs(ref))
     d = r.to_dict()["disturbances"][0]
     assert d["direction"] is None and d["peak_force_N"] == pytest.approx(np.hypot(100, 30))
+
+
+def test_bare_numbers_take_the_models_unit_system():
+    # the IOC file declares units = "US": a bare f0 is lbf (25 lbf = 111.205 N exactly by
+    # the definitions lbf = 0.45359237 kg x 9.80665 m/s^2), so it gives the same peak as
+    # "25 lbf" bit for bit, and differs from 25 N by the ratio of the forces (linearity)
+    import microg
+
+    st = microg.load_station("ioc")
+    assert st.unit_system == "US"
+    kw = dict(at="crew", observe=["lab"], duration="100 s", dt="0.02 s")
+
+    def peak(f: str) -> float:
+        return microg.analyze(st, force=f, **kw).observations["lab"].peak_accel_g
+
+    bare, lbf, newton = (peak(f"crew-pushoff:f0=25{u}") for u in ("", " lbf", " N"))
+    assert bare == lbf
+    assert bare / newton == pytest.approx(4.4482216152605, rel=1e-9)
+    # a model without a declared system refuses the bare number, naming the parameter
+    si = load_station(Path(__file__).parent / "data" / "models" / "small_si.toml")
+    assert si.unit_system is None
+    with pytest.raises(microg.InputError, match="no unit"):
+        microg.analyze(si, force="crew-pushoff:f0=25", duration="100 s")

@@ -454,10 +454,8 @@ def _bare_unit(dimension: str, unit_system: str | None) -> str | None:
     """Unit of a bare number of ``dimension`` in a model's unit system (None: SI)."""
     if unit_system is None:
         return None
-    try:
-        from microg.models.toml import UNIT_SYSTEMS
-    except ImportError:  # pragma: no cover - the model loader defines it
-        return None
+    from microg.models.toml import UNIT_SYSTEMS
+
     table = UNIT_SYSTEMS.get(unit_system, {})
     return table.get(dimension)
 
@@ -486,7 +484,13 @@ def _directions(value: Any) -> list[Any]:
     return items
 
 
-def _forces(force: Any) -> list[ForceHistory]:
+def _forces(force: Any, unit_system: str | None = None) -> list[ForceHistory]:
+    """Force histories from specs; bare parameter values take the model's unit system."""
+    bare: dict[str, str] | None = None
+    if unit_system is not None:
+        from microg.models.toml import UNIT_SYSTEMS
+
+        bare = UNIT_SYSTEMS.get(unit_system)
     specs = _as_list(force) or [DEFAULTS["force"]]
     out = []
     for i, spec in enumerate(specs):
@@ -494,7 +498,7 @@ def _forces(force: Any) -> list[ForceHistory]:
         if isinstance(spec, ForceHistory):
             out.append(spec)
         elif isinstance(spec, str | Path):
-            out.append(parse_force_spec(str(spec), where=where))
+            out.append(parse_force_spec(str(spec), where=where, bare_units=bare))
         else:
             raise InputError(
                 f"cannot use {spec!r} as a force",
@@ -648,7 +652,7 @@ def analyze(
     mdl = _load(model)
     units = getattr(mdl, "unit_system", None)
     catalogue = _sources(sources)
-    forces = [] if (catalogue is not None and force is None) else _forces(force)
+    forces = [] if (catalogue is not None and force is None) else _forces(force, units)
     nf = len(forces)
     points = _point_names(mdl)
     known = [p for p, _ in points]
@@ -885,33 +889,68 @@ def _with_exact_peak(a: Assessment, peak: PeakResponse, req: Requirement) -> Ass
     )
 
 
+class _ModalSeries:
+    """The modal accelerations (k, nt) of a run, with the per-mode quantities every point shares.
+
+    A point's per-mode series is its map coefficient times the modal acceleration, so its
+    peak and band RMS are ``|coefficient|`` times the modal one (the PSD scales with the
+    square: demeaning, the periodogram and the band sum are linear in ``|X|^2``); these are
+    computed once per run, not once per observed point.
+    """
+
+    def __init__(self, t: np.ndarray, acc: np.ndarray):
+        self.t = t
+        self.acc = acc
+        self._peak: np.ndarray | None = None
+        self._spec: Any = None
+        self._band: dict[float, np.ndarray] = {}
+
+    def peak_abs(self) -> np.ndarray:
+        """``max_t |acc_j(t)|`` per mode, m/s^2 (k,)."""
+        if self._peak is None:
+            self._peak = np.max(np.abs(self.acc), axis=1)
+        return self._peak
+
+    def band_rms(self, center_hz: float, lower_hz: float, upper_hz: float) -> np.ndarray:
+        """RMS of each modal acceleration in one band, m/s^2 (k,)."""
+        key = float(center_hz)
+        if key not in self._band:
+            if self._spec is None:
+                self._spec = acceleration_psd(self.t, self.acc)
+            bands = BandTable(np.array([center_hz]), np.array([lower_hz]), np.array([upper_hz]))
+            self._band[key] = band_rms(self._spec, bands).rms[:, 0]
+        return self._band[key]
+
+
 def _contributions(
     mode_numbers: np.ndarray,
     m: Modes,
     tphi: np.ndarray,
-    acc_modal: np.ndarray,
-    t: np.ndarray,
+    modal: _ModalSeries,
     a: Assessment,
     acc_at_peak: np.ndarray,
 ) -> ModeContributions:
-    """Per-mode contributions at a point (``acc_at_peak``: modal accelerations at the peak)."""
+    """Per-mode contributions at a point (``acc_at_peak``: modal accelerations at the peak).
+
+    Mode j's own series at the point is ``tphi[:, j] acc_j(t)``: its peak magnitude is
+    ``|tphi[:, j]| max_t |acc_j|`` and its band RMS on an axis ``|tphi[ax, j]|`` times the
+    band RMS of ``acc_j`` (:class:`_ModalSeries`).
+    """
     total = tphi @ acc_at_peak  # (3,)
     size = float(np.linalg.norm(total))
     u = total / size if size > 0 else np.zeros(3)
     at_peak = (u @ tphi) * acc_at_peak / G0
-    own = np.max(np.linalg.norm(tphi[:, :, None] * acc_modal[None, :, :], axis=0), axis=1) / G0
+    own = np.linalg.norm(tphi, axis=0) * modal.peak_abs() / G0
     wb = a.worst_band
     band_rms_g = None
     band_hz = None
     axis = None
     if wb is not None and np.isfinite(wb.margin):
         ax = "xyz".index(wb.axis) if wb.axis in "xyz" else 0
-        series = tphi[ax, :, None] * acc_modal  # (k, nt)
-        spec = acceleration_psd(t, series)
         to = a.third_octave
         i = int(np.argmin(np.abs(to.center_hz - wb.center_hz)))
-        bands = BandTable(to.center_hz[i : i + 1], to.lower_hz[i : i + 1], to.upper_hz[i : i + 1])
-        band_rms_g = band_rms(spec, bands).rms[:, 0] / G0
+        rms = modal.band_rms(to.center_hz[i], to.lower_hz[i], to.upper_hz[i])
+        band_rms_g = np.abs(tphi[ax]) * rms / G0
         band_hz = float(wb.center_hz)
         axis = wb.axis
     return ModeContributions(
@@ -1114,12 +1153,13 @@ def _transient(
     peaks = peak_response(m.omega, zeta, m.phi, maps, [(ld.force, ld.b) for ld in loads], t)
     observations: dict[str, Observation] = {}
     mode_numbers = idx + 1
+    modal = _ModalSeries(t, acc)
     for name, tmap in maps.items():
         tphi = tmap @ m.phi
         resp = PointResponse(name, t, tphi @ eta, tphi @ vel, tphi @ acc)
         a = _with_exact_peak(assess(t, resp.acceleration, req), peaks[name], req)
         contrib = _contributions(
-            mode_numbers, m, tphi, acc, t, a, _modal_accel_at(m, zeta, loads, peaks[name])
+            mode_numbers, m, tphi, modal, a, _modal_accel_at(m, zeta, loads, peaks[name])
         )
         observations[name] = Observation(
             name=name,

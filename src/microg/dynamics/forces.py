@@ -22,6 +22,7 @@ import contextlib
 import csv
 import re
 import tomllib
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from functools import lru_cache
 from importlib import resources
@@ -721,7 +722,9 @@ _PARAMS_FIX = (
 )
 
 
-def _parse_params(text: str, where: str) -> dict[str, float]:
+def _parse_params(
+    text: str, where: str, bare_units: Mapping[str, str] | None = None
+) -> dict[str, float]:
     params: dict[str, float] = {}
     if not text.strip():  # "crew-pushoff:" is the spec without parameters
         return params
@@ -742,7 +745,10 @@ def _parse_params(text: str, where: str) -> dict[str, float]:
             raise InputError(f"cannot read parameter {item!r}", where=where, fix=_PARAMS_FIX)
         if key in params:
             raise InputError(f"parameter {key} is given twice", where=where, fix=_PARAMS_FIX)
-        params[key] = parse_quantity(value.strip(), _PARAM_DIMENSION[key], where=f"{where}: {key}")
+        dim = _PARAM_DIMENSION[key]
+        params[key] = parse_quantity(
+            value.strip(), dim, where=f"{where}: {key}", default_unit=(bare_units or {}).get(dim)
+        )
     return params
 
 
@@ -753,7 +759,9 @@ def _is_file(path: Path) -> bool:
         return False
 
 
-def parse_force_spec(spec: str, *, where: str = "force") -> ForceHistory:
+def parse_force_spec(
+    spec: str, *, where: str = "force", bare_units: Mapping[str, str] | None = None
+) -> ForceHistory:
     """A force history from a spec string.
 
     Accepted: ``crew-pushoff`` (the report's Eq. 2.16 values); ``crew-pushoff:f0=40lbf,t1=0.5s``
@@ -765,6 +773,8 @@ def parse_force_spec(spec: str, *, where: str = "force") -> ForceHistory:
     ----------
     spec : the spec text
     where : parameter name for error messages
+    bare_units : unit of a bare parameter value per dimension (``{"force": "lbf", "time":
+        "s"}``: the model's unit system); None: a bare value is refused
     """
     if not isinstance(spec, str):
         raise InputError(f"expected a force spec string, got {type(spec).__name__}", where=where)
@@ -778,7 +788,7 @@ def parse_force_spec(spec: str, *, where: str = "force") -> ForceHistory:
     key = head.strip().lower()
     path = Path(spec)
     if key in ("crew-pushoff", *lib) and not _is_file(path):
-        params = _parse_params(tail, f"{where} {spec}") if sep else {}
+        params = _parse_params(tail, f"{where} {spec}", bare_units) if sep else {}
         try:
             if key == "crew-pushoff":
                 return lib["report-pushoff"].history(name="crew-pushoff", **params)

@@ -222,6 +222,7 @@ class Builder:
             reference_length=ref_length,
             description=st.description,
             source=self.source,
+            unit_system=st.units or None,
         )
 
     def orbit(self) -> Orbit:

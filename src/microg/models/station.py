@@ -212,6 +212,9 @@ class Station:
     description : str
     source : str
         File it was read from, if any.
+    unit_system : {"SI", "US"} or None
+        The file's declared unit system (``units`` in ``[station]``): the unit of a bare
+        number given to the API or the CLI for this model (None: SI).
     """
 
     name: str
@@ -222,6 +225,7 @@ class Station:
     reference_length: float = 1.0
     description: str = ""
     source: str = ""
+    unit_system: str | None = None
 
     def all_masses(self) -> list[PointMass]:
         """Every point mass on bodies and beams."""
