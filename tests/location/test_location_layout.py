@@ -297,3 +297,10 @@ def test_result_to_dict_and_plot(small):
     assert d["improvement"] == pytest.approx(res.improvement)
     assert d["masses"][0]["key"] == "core/dock"
     assert isinstance(res.plot(), Figure)
+    # to_xarray: the same coordinates and objective as the result (same numbers, same units)
+    ds = res.to_xarray()
+    assert all("units" in v.attrs for v in ds.data_vars.values())
+    np.testing.assert_array_equal(ds.position_m.sel(layout="initial").values, res.initial)
+    np.testing.assert_array_equal(ds.position_m.sel(layout="optimal").values, res.optimal)
+    assert ds.lower_m.values.tolist() == [-20.0] and ds.upper_m.values.tolist() == [-4.0]
+    assert float(ds.objective_g.sel(layout="optimal")) == res.objective_optimal / G0

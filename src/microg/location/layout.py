@@ -205,6 +205,36 @@ class LayoutResult:
             "message": self.message,
         }
 
+    def to_xarray(self) -> Any:
+        """The movable masses' coordinates at both layouts as an ``xarray.Dataset``.
+
+        Dims ``mass`` (the masses' keys) and ``layout`` (``initial``, ``optimal``):
+        ``position_m`` (m), ``lower_m``/``upper_m`` bounds; the objective (g) per layout.
+        """
+        import xarray as xr
+
+        keys = [mm.key for mm in self.masses]
+        pos = np.column_stack([self.initial, self.optimal]).reshape(len(keys), 2)
+        bounds = np.array([mm.bounds for mm in self.masses], float).reshape(len(keys), 2)
+        obj = np.array([self.objective_initial, self.objective_optimal]) / G0
+        return xr.Dataset(
+            {
+                "position_m": (("mass", "layout"), pos, {"units": "m"}),
+                "lower_m": ("mass", bounds[:, 0], {"units": "m"}),
+                "upper_m": ("mass", bounds[:, 1], {"units": "m"}),
+                "objective_g": ("layout", obj, {"units": "g", "measure": self.measure}),
+            },
+            coords={"mass": keys, "layout": ["initial", "optimal"]},
+            attrs={
+                "model": self.model,
+                "experiment_point": self.experiment,
+                "crew_point": self.crew,
+                "measure": self.measure,
+                "n_evaluations": self.n_evaluations,
+                "success": int(self.success),
+            },
+        )
+
     def plot(self) -> Any:
         """Peaks at the site before and after (:func:`microg.plotting.location.plot_layout`)."""
         from microg.plotting.location import plot_layout
