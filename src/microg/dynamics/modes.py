@@ -298,7 +298,11 @@ def _modal_mass_unit_peak(structure: Structure, phi: np.ndarray) -> np.ndarray:
         peaks.append(np.max(np.abs(t), axis=0))
         peaks.append(lc * np.max(np.abs(rot), axis=0))
     samples = structure.samples
-    if samples is not None and hasattr(samples, "displacement"):
+    if samples is not None and hasattr(samples, "peak_translation"):
+        # modal-model samples (microg.structure.modal.ModalSamples): the largest translation
+        # of each column without forming the (grids, 3, modes) displacements
+        peaks.append(np.asarray(samples.peak_translation(phi), float))
+    elif samples is not None and hasattr(samples, "displacement"):
         # sparse-friendly samples (microg.structure.fem.NodeSamples): translations + rotations
         peaks.append(np.max(np.abs(samples.displacement(phi)), axis=(0, 1)))
         rot_index = getattr(samples, "rot_index", None)

@@ -39,6 +39,8 @@ __all__ = [
 ]
 
 _DIRECTIONS = ("x", "y", "z", "rx", "ry", "rz")
+#: grids per block of the shape-peak pass (a block of |phi_t| stays in cache)
+_PEAK_BLOCK = 2048
 
 
 def _skew(d: np.ndarray) -> np.ndarray:
@@ -185,7 +187,12 @@ class ModalSamples:
     def shape_peaks(self) -> np.ndarray:
         """Largest |translation| of each of the model's shapes over grids and axes (m,)."""
         if self._peak is None:
-            self._peak = np.max(np.abs(self.phi_t), axis=(0, 1))
+            # in blocks of grids: no (g, 3, m) temporary of |phi_t| (max commutes with blocks)
+            pt = self.phi_t
+            peak = np.zeros(pt.shape[2])
+            for i in range(0, pt.shape[0], _PEAK_BLOCK):
+                np.maximum(peak, np.max(np.abs(pt[i : i + _PEAK_BLOCK]), axis=(0, 1)), out=peak)
+            self._peak = peak
         return self._peak
 
     def peak_translation(self, q: np.ndarray) -> np.ndarray:
