@@ -587,7 +587,8 @@ def _finish(
             x = x - b @ np.asarray((mass @ b).T @ x)
     k_abs: Any = abs(stiffness)
     ax = np.abs(x)
-    energy_bound = _EPS * np.sum(ax * np.asarray(k_abs @ ax), axis=0)  # eps |x|^T |K| |x|
+    kax = np.asarray(k_abs @ ax)  # |K| |x|, for the energy bound and the backward error
+    energy_bound = _EPS * np.sum(ax * kax, axis=0)  # eps |x|^T |K| |x|
     zero = np.abs(lam) <= energy_bound
     if check_zero and np.any(zero):
         raise InputError(
@@ -603,9 +604,7 @@ def _finish(
     # Appl. 20: ||r|| / (|| |K||x| || + |lambda| || |M||x| ||)): the mass term matters for the
     # highest modes, which live where the mass is small
     m_abs: Any = abs(mass)
-    den = np.linalg.norm(np.asarray(k_abs @ ax), axis=0) + np.abs(lam) * np.linalg.norm(
-        np.asarray(m_abs @ ax), axis=0
-    )
+    den = np.linalg.norm(kax, axis=0) + np.abs(lam) * np.linalg.norm(np.asarray(m_abs @ ax), axis=0)
     den = np.maximum(den, np.finfo(float).tiny)
     if lam.size and np.any(res / den > RESIDUAL_TOL):
         raise SolverError(

@@ -291,28 +291,28 @@ class TreeFlexibility:
         self._lu = spla.splu(tree.kinematics().tocsc(), permc_spec="NATURAL", diag_pivot_thresh=0.0)
         k = np.asarray(tree.root_stiffness, float)
         root_inv = np.divide(1.0, k, out=np.zeros(6), where=k != 0.0)
-        # D^+ as one block-diagonal sparse matrix (a single compiled product per application)
-        child = 6 * tree.child[:, None] + np.arange(6)
-        rows = np.broadcast_to(child[:, :, None], tree.flexibility.shape).ravel()
-        cols = np.broadcast_to(child[:, None, :], tree.flexibility.shape).ravel()
-        root = 6 * tree.root + np.arange(6)
-        self._dplus = sp.csr_matrix(
-            (
-                np.concatenate([tree.flexibility.ravel(), root_inv]),
-                (np.concatenate([rows, root]), np.concatenate([cols, root])),
-            ),
+        # D^+ as one block-diagonal BSR matrix of 6 x 6 blocks, block row = node (each node
+        # but the root is the child of exactly one element; the root's block is its
+        # restraint's inverse): no assembly sort, one compiled block product per application
+        blocks = np.zeros((tree.n_nodes, 6, 6))
+        blocks[tree.child] = tree.flexibility
+        blocks[tree.root] = np.diag(root_inv)
+        self._dplus = sp.bsr_matrix(
+            (blocks, np.arange(tree.n_nodes), np.arange(tree.n_nodes + 1)),
             shape=(self.n, self.n),
         )
 
     def __call__(self, y: np.ndarray) -> np.ndarray:
         """``G y`` for ``y`` (n,) or (n, k): N and N m in, m and rad out."""
         y = np.asarray(y, float)
-        one = y.ndim == 1
-        yy = y.reshape(self.n, -1)
-        z = self._lu.solve(yy, trans="T")  # internal forces carried by each element
-        w = self._dplus @ z  # each element's deformation under its own load
-        x = self._lu.solve(w)  # deformations summed out from the root
-        return x.ravel() if one else x
+        if y.ndim == 1:
+            z = self._lu.solve(y, trans="T")  # internal forces carried by each element
+            return self._lu.solve(self._dplus @ z)  # element deformations summed from the root
+        # several loads: SuperLU solves column by column on Fortran-ordered arrays (a C-ordered
+        # block would be copied twice)
+        z = self._lu.solve(np.asfortranarray(y.reshape(self.n, -1)), trans="T")
+        w = np.asfortranarray(self._dplus @ z)
+        return self._lu.solve(w)
 
 
 def _frame_tree(
