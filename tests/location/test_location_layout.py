@@ -132,23 +132,12 @@ def test_bare_numbers_take_the_models_unit_system(small):
     assert mm.bounds == pytest.approx((-20.0, -13.12 * FT), rel=1e-15)
     # no unit system: a bare number is an error naming the parameter and the fix
     with pytest.raises(InputError, match="no unit") as exc:
-        movable_masses(small, {"dock": ("-20", "-4")})
+        movable_masses(dataclasses.replace(small, unit_system=None), {"dock": ("-20", "-4")})
     assert exc.value.where == "movable core/dock" and 'units = "SI"' in exc.value.fix
-    # the station's own unit system, when the loader records it, is the default
-    st = _with_unit_system(small, "SI")
+    # the station's own unit system (the loader records [station] units) is the default
+    st = dataclasses.replace(small, unit_system="SI")
     (mm,) = movable_masses(st, {"dock": ("-20", "-4")})
     assert mm.bounds == (-20.0, -4.0)
-
-
-def _with_unit_system(station, system):
-    """A station that carries ``unit_system`` (what the model loader is to record)."""
-
-    @dataclasses.dataclass(frozen=True)
-    class WithUnits(type(station)):
-        unit_system: str | None = None
-
-    fields = {f.name: getattr(station, f.name) for f in dataclasses.fields(station)}
-    return WithUnits(**fields, unit_system=system)
 
 
 def test_fast_path_equals_the_one_entry():
