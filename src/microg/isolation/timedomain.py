@@ -262,13 +262,15 @@ def _commensurate(
     h_fine = span / total
     # the refined grid must place every sample as close to its given time as the grouped
     # steps do (both are off by the rounding accumulated in the given times only)
-    # (time reached after j steps, with exact integer step counts: one rounding per entry)
-    given = t[1:] - t[0]
-    pos = np.cumsum(counts) * h_fine
-    grouped = np.zeros(index.size)
-    for u, h_u in enumerate(h_unique):
-        grouped += np.cumsum(index == u) * h_u
-    if np.max(np.abs(pos - given)) > max(float(np.max(np.abs(grouped - given))), tol):
+    # time reached after j steps: refined pos_j = (sum of counts) h_fine (one rounding), grouped
+    # pos_j + sum of (h_u - m_u h_fine) over the steps (tiny residuals: their cumsum rounds at
+    # ~1e-16 of their own size)
+    off_given = np.cumsum(counts) * h_fine
+    off_given -= t[1:]
+    off_given += t[0]  # pos - given
+    refined = float(np.max(np.abs(off_given)))
+    off_given += np.cumsum((h_unique - m * h_fine)[index])  # grouped - given
+    if refined > max(float(np.max(np.abs(off_given))), tol):
         return None
     return counts, h_fine
 
@@ -283,9 +285,15 @@ def _refine(
     """
     total = int(counts.sum())
     first = np.cumsum(counts) - counts  # fine index of every step's start
-    i = np.arange(total) - np.repeat(first, counts)  # fine steps into the step
-    out = np.repeat(inputs, counts, axis=0)
-    out[:, 0] += out[:, 1] * (i * h_fine)
+    owner = np.zeros(total, dtype=np.intp)  # the step each fine step belongs to
+    owner[first[1:]] = 1
+    np.cumsum(owner, out=owner)
+    out = np.take(inputs, owner, axis=0)
+    i = np.arange(total, dtype=float)
+    i -= np.take(first, owner)  # fine steps into the step
+    i *= h_fine
+    i *= out[:, 1]
+    out[:, 0] += i
     return out
 
 
