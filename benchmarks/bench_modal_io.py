@@ -3,10 +3,14 @@
 The path a user calls: ``microg.analyze(microg.load_model(path), force="crew-pushoff",
 at="grid:1", observe=[10 grids], duration=200 s, dt=0.01 s)`` -- the push-off at one grid
 observed at 10 grids over 200 s at 0.01 s (200 modes x 20,001 samples).  The baseline is
-reading the file alone (``microg.load_model``) in the same process; the issue asks the
-analysis to take less than 3x that.  Printed: read and analysis times, their ratio, the
-time of each stage of the analysis (``progress`` callback), and the analysis without the
-isolation advice.  ``--profile`` adds the costliest functions of one analysis (cProfile).
+reading the file alone (``microg.load_model``, the file just written: in the page cache) in
+the same process; the issue asks the analysis to take less than 3x that.  Each time is the
+least of a few runs (3 reads, 2 analyses: the machine's noise only adds time).  Printed:
+read and analysis times, their ratio, the time of each stage of the analysis (``progress``
+callback), the analysis without the isolation advice, and the fixed cost (the same analysis
+of the model cut to 200 of its grids, the loaded and observed ones among them: the work
+that does not grow with the grids).  ``--profile`` adds the costliest functions of one
+analysis (cProfile).
 
 Run: .venv/bin/python benchmarks/bench_modal_io.py [--grids N] [--modes M] [--uff] [--profile]
 (--uff also times the full-size UFF text file, ~0.4 GB: minutes; by default the UFF path is
@@ -17,10 +21,12 @@ from __future__ import annotations
 
 import argparse
 import cProfile
+import hashlib
 import io
 import pstats
 import tempfile
 import time
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -32,6 +38,11 @@ from microg.models.uff import write_uff_modes
 
 DURATION_S = 200.0
 DT_S = 0.01
+#: grids of the small model whose analysis is the grid-independent (fixed) cost
+FIXED_GRIDS = 200
+#: the read and the analyses are timed as the least of a few runs (noise only adds time)
+READ_REPEAT = 3
+REPEAT = 2
 
 
 def make_model(g: int, m: int) -> Any:
@@ -64,6 +75,21 @@ def observed(g: int) -> list[str]:
     return [f"grid:{i}" for i in np.linspace(100, g, 10).astype(int)]
 
 
+def grid_subset(model: Any, n: int) -> Any:
+    """The model at ``n`` of its grids: grid 1, the observed ones and others spread between.
+
+    The same modes at the loaded and observed grids: the same response, peaks and advice,
+    so its analysis is the work of this one that does not grow with the grids.
+    """
+    g = model.n_grids
+    keep = {0, *(int(s.split(":")[1]) - 1 for s in observed(g))}
+    keep |= set(np.linspace(0, g - 1, max(n - len(keep), 0)).astype(int).tolist())
+    rows = np.array(sorted(keep))
+    return replace(
+        model, grid_ids=model.grid_ids[rows], xyz_m=model.xyz_m[rows], phi=model.phi[rows]
+    )
+
+
 def analyse(model: Any, g: int, *, isolation: bool = True) -> tuple[float, dict[str, float]]:
     """Time of ``microg.analyze`` on the model read, and of each of its stages, s."""
     stages: dict[str, float] = {}
@@ -91,10 +117,20 @@ def analyse(model: Any, g: int, *, isolation: bool = True) -> tuple[float, dict[
     return end - t0, stages
 
 
-def timed(f: Any) -> tuple[float, Any]:
-    t0 = time.perf_counter()
-    out = f()
-    return time.perf_counter() - t0, out
+def timed(f: Any, repeat: int = 1) -> tuple[float, Any]:
+    """Least time of ``repeat`` calls of f, s, and the last result."""
+    best = float("inf")
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        out = f()
+        best = min(best, time.perf_counter() - t0)
+    return best, out
+
+
+def best_analysis(model: Any, g: int, *, isolation: bool = True) -> tuple[float, dict[str, float]]:
+    """The fastest of REPEAT analyses (time, stages): the machine's noise only adds time."""
+    runs = [analyse(model, g, isolation=isolation) for _ in range(REPEAT)]
+    return min(runs, key=lambda r: r[0])
 
 
 def main() -> None:
@@ -112,13 +148,26 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as d:
         p = Path(d) / "m.npz"
         tw, _ = timed(lambda: save_modal_model(model, p))
-        tr, back = timed(lambda: microg.load_model(p))
-        ta, stages = analyse(back, a.grids)
-        tn, _ = analyse(back, a.grids, isolation=False)
+        tr, back = timed(lambda: microg.load_model(p), repeat=READ_REPEAT)
+        ta, stages = best_analysis(back, a.grids)
+        tn, _ = best_analysis(back, a.grids, isolation=False)
         print(f"own .npz ({p.stat().st_size / 1e6:.0f} MB): write {tw:.2f} s, read {tr:.2f} s")
         print(f"analysis {ta:.2f} s: " + ", ".join(f"{k} {v:.2f}" for k, v in stages.items()))
         print(f"ratio analysis / read (own format): {ta / tr:.2f} (issue 11: < 3)")
         print(f"  without the isolation advice: {tn:.2f} s, ratio {tn / tr:.2f}")
+        # the part of the analysis that does not grow with the grids: the same modes, the
+        # same run, on a model of FIXED_GRIDS grids (a diagnostic; the ratio above is the test)
+        pf = Path(d) / "fixed.npz"
+        save_modal_model(grid_subset(back, FIXED_GRIDS), pf)
+        tf, _ = best_analysis(microg.load_model(pf), a.grids)
+        th, _ = timed(lambda: hashlib.sha256(p.read_bytes()).hexdigest(), repeat=READ_REPEAT)
+        grows = stages["structure"] + stages["modes"] + th
+        print(
+            f"  fixed cost (the same analysis of the model cut to {FIXED_GRIDS} grids): {tf:.2f} s"
+            f" = {tf / tr:.1f} reads (the ratio cannot fall below it); the steps that grow with"
+            f" the grids: structure {stages['structure']:.2f} + modes {stages['modes']:.2f} +"
+            f" the provenance hash of the file {th:.2f} = {grows:.2f} s = {grows / tr:.2f} reads"
+        )
         if a.profile:
             prof = cProfile.Profile()
             prof.enable()

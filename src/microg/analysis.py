@@ -1154,9 +1154,14 @@ def _transient(
     observations: dict[str, Observation] = {}
     mode_numbers = idx + 1
     modal = _ModalSeries(t, acc)
-    for name, tmap in maps.items():
-        tphi = tmap @ m.phi
-        resp = PointResponse(name, t, tphi @ eta, tphi @ vel, tphi @ acc)
+    # every point's rows in one product per series (one GEMM, not one per point)
+    rows = [tmap @ m.phi for tmap in maps.values()]
+    tphi_all = np.concatenate(rows) if rows else np.zeros((0, m.n_modes))
+    d_all, v_all, a_all = tphi_all @ eta, tphi_all @ vel, tphi_all @ acc
+    for j, name in enumerate(maps):
+        r = slice(3 * j, 3 * j + 3)
+        tphi = tphi_all[r]
+        resp = PointResponse(name, t, d_all[r], v_all[r], a_all[r])
         a = _with_exact_peak(assess(t, resp.acceleration, req), peaks[name], req)
         contrib = _contributions(
             mode_numbers, m, tphi, modal, a, _modal_accel_at(m, zeta, loads, peaks[name])

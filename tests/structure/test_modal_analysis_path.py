@@ -95,12 +95,18 @@ def test_contributions_equal_each_modes_own_series():
     zeta = np.where(m.rigid, 0.0, opts.zeta)
     loads, _ = _modal_forces(st, m, opts)
     t = res.timepts
-    _, _, acc = _modal_acceleration(m, zeta, loads, t)
+    eta, _, acc = _modal_acceleration(m, zeta, loads, t)
     checked_band = 0
     for name in obs:
         c = res.observations[name].contributions
         a = res.observations[name].assessment
         tphi = st.point(name).translation @ m.phi
+        # the point's response (all points' rows in one product) equals the point's own
+        # product; another summation blocking of the same k terms: rounding, 1e-12
+        ob = res.observations[name]
+        for got, modal in ((ob.response.displacement, eta), (ob.response.acceleration, acc)):
+            ref_pt = tphi @ modal
+            np.testing.assert_allclose(got, ref_pt, rtol=0, atol=1e-12 * np.abs(ref_pt).max())
         series = tphi[:, :, None] * acc[None, :, :]  # (3, k, nt): each mode's own series
         # reference: the peak of each mode's own acceleration magnitude over the samples;
         # |c a(t)| = |c| |a(t)| up to one rounding per product: 1e-14 relative
