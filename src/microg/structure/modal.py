@@ -40,7 +40,7 @@ __all__ = [
 
 _DIRECTIONS = ("x", "y", "z", "rx", "ry", "rz")
 #: grids per block of the shape-peak pass (a block of |phi_t| stays in cache)
-_PEAK_BLOCK = 2048
+_PEAK_BLOCK = 512
 
 
 def _skew(d: np.ndarray) -> np.ndarray:
