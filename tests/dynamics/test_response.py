@@ -315,11 +315,16 @@ def test_superposition(times, v1, v2, c):
     times=_times, vals=st.lists(st.floats(-5, 5), min_size=8, max_size=8), shift=st.floats(0, 50)
 )
 def test_time_shift_invariance(times, vals, shift):
-    tb = np.array(times)
-    fb = np.array(vals[: tb.size])
-    tout = np.linspace(0, 25, 251)
+    tb1 = np.array(times) + shift
+    fb = np.array(vals[: tb1.size])
+    tout1 = np.linspace(0, 25, 251) + shift
+    # the unshifted problem is the shifted one moved back (exact by Sterbenz's lemma for the
+    # times below shift, else one rounding of ulp(t)): a breakpoint gap of 1e-12 s that the
+    # shift itself rounds by 1e-4 of its length is then the same gap in both problems
+    tb = tb1 - shift
+    tout = tout1 - shift
     r0 = modal_pwl_response(OMEGA, ZETA, tb, np.tile(fb, (7, 1)), tout)
-    r1 = modal_pwl_response(OMEGA, ZETA, tb + shift, np.tile(fb, (7, 1)), tout + shift)
+    r1 = modal_pwl_response(OMEGA, ZETA, tb1, np.tile(fb, (7, 1)), tout1)
     scale = np.abs(r0.eta).max() + 1e-300
     # shifting times by up to 50 s perturbs them by ~ulp(50) = 7e-15 s; the response changes
     # by omega * 7e-15 relative at most (omega <= 40): 1e-10 of the peak bounds it

@@ -145,23 +145,22 @@ def _step_ramp_series(
     started from S: a_2 = tau^2/2 and R: a_3 = tau^3/6.
     """
     x2 = x * x
-    # S series
-    a_prev = np.zeros_like(tau)  # a_1
-    a_cur = 0.5 * tau * tau  # a_2
-    s_sum = a_cur.copy()
-    # R series
-    r_prev = np.zeros_like(tau)  # a_2
-    r_cur = tau * tau * tau / 6.0  # a_3
-    r_sum = r_cur.copy()
+    # S: a_1 = 0, a_2 = tau^2/2; R: a_2 = 0, a_3 = tau^3/6.  In place, two rotating buffers each
+    s_prev, s_cur = np.zeros_like(tau), 0.5 * tau * tau
+    r_prev, r_cur = np.zeros_like(tau), tau * tau * tau / 6.0
+    s_sum, r_sum = s_cur.copy(), r_cur.copy()
+    tmp = np.empty_like(tau)
     for n in range(1, _SERIES_TERMS):
-        # S: next is a_{n+2} from a_{n+1} (cur) and a_n (prev)
-        nxt = -((n + 1) * two_sigma_tau * a_cur + x2 * a_prev) / ((n + 2) * (n + 1))
-        a_prev, a_cur = a_cur, nxt
-        s_sum += nxt
-        k = n + 1  # R: a_{k+2} from a_{k+1}, a_k
-        rnxt = -((k + 1) * two_sigma_tau * r_cur + x2 * r_prev) / ((k + 2) * (k + 1))
-        r_prev, r_cur = r_cur, rnxt
-        r_sum += rnxt
+        # S: a_{n+2} = -((n+1) 2 sigma tau a_{n+1} + x^2 a_n) / ((n+2)(n+1)); R: the same, n+1
+        for k, prev, cur, total in ((n, s_prev, s_cur, s_sum), (n + 1, r_prev, r_cur, r_sum)):
+            np.multiply(cur, two_sigma_tau, out=tmp)
+            tmp *= k + 1
+            prev *= x2  # becomes the next coefficient (a_n is not needed again)
+            prev += tmp
+            prev /= -((k + 2) * (k + 1))
+            total += prev
+        s_prev, s_cur = s_cur, s_prev
+        r_prev, r_cur = r_cur, r_prev
     return s_sum, r_sum
 
 
@@ -409,7 +408,15 @@ def _runs(t: np.ndarray, starts: np.ndarray) -> tuple[list[tuple[int, int, int]]
     return runs, np.flatnonzero(mask)
 
 
-def _table_run(st: _State, k: int, tau: np.ndarray, qs: tuple[int, ...], dest: np.ndarray) -> None:
+def _table_run(
+    st: _State,
+    k: int,
+    tau: np.ndarray,
+    qs: tuple[int, ...],
+    dest: np.ndarray,
+    defer: list[tuple[int, np.ndarray, np.ndarray, np.ndarray]] | None = None,
+    offset: int = 0,
+) -> None:
     """Quantities ``qs`` (0 eta, 1 eta', 2 eta'') of all modes on a uniform run of segment k.
 
     Writes ``dest`` (len(qs), m, n).  Elastic modes: with E = exp(lambda tau), lambda =
@@ -499,7 +506,9 @@ def _table_run(st: _State, k: int, tau: np.ndarray, qs: tuple[int, ...], dest: n
             tg[:, :, full_blocks * L :] = (lh[:, :, -1, None, :] @ rh[:, :, :rem])[:, :, 0]
     # stable recomputation of eta, eta' where omega tau < _SERIES_BELOW: only those entries (a
     # prefix of the run for each mode), gathered flat, so a run starting at a breakpoint costs
-    # about sum_j 0.5 / (omega_j dt) evaluations instead of a (modes x longest prefix) block
+    # about sum_j 0.5 / (omega_j dt) evaluations instead of a (modes x longest prefix) block;
+    # with ``defer`` they are handed back (segment, mode, column offset + i, tau) and written by
+    # the caller, all runs in one call of :func:`_small_tau_values`
     fix = [iq for iq, q in enumerate(qs) if q < 2]
     if fix:
         n_small = np.searchsorted(tau, _SERIES_BELOW / omega, side="left")
@@ -510,17 +519,42 @@ def _table_run(st: _State, k: int, tau: np.ndarray, qs: tuple[int, ...], dest: n
             rows_f = np.repeat(sel, cnt)  # elastic-mode index of each entry
             starts_f = np.cumsum(cnt) - cnt
             cols_f = np.arange(total) - np.repeat(starts_f, cnt)  # position in the run
-            g, h, S, R = oscillator_functions(omega[rows_f], zeta[rows_f], tau[cols_f])
-            assert R is not None
-            ee, vv, aa = e0[rows_f], v0[rows_f], a0[rows_f]
-            stable = (
-                ee * g + vv * h + p0[rows_f] * S + s0[rows_f] * R,
-                vv * g + aa * h + s0[rows_f] * S,
-            )
-            for iq in fix:
-                target[iq][rows_f, cols_f] = stable[qs[iq]]
+            if defer is not None:
+                defer.append((k, el[rows_f], cols_f + offset, tau[cols_f]))
+            else:
+                vals = _small_tau_values(st, np.full(total, k), el[rows_f], tau[cols_f], qs)
+                for iq in fix:
+                    target[iq][rows_f, cols_f] = vals[iq]
     if not contiguous:
         dest[:, el] = target
+
+
+def _small_tau_values(
+    st: _State, seg: np.ndarray, mode: np.ndarray, tau: np.ndarray, qs: tuple[int, ...]
+) -> list[np.ndarray | None]:
+    """eta, eta' (those of ``qs`` below 2) of single entries (segment, mode, elapsed time).
+
+    The closed form ``e g + v h + p S + s R`` and ``v g + a h + s S`` with S, R from their
+    series (every entry has ``omega tau < _SERIES_BELOW``); None for the other quantities.
+    """
+    omega, zeta = st.omega[mode], st.zeta[mode]
+    sigma_tau = zeta * omega * tau
+    theta = omega * np.sqrt(1.0 - zeta * zeta) * tau
+    tsinc = tau * _sinc(theta)  # sin(omega_d tau) / omega_d
+    decay = np.exp(-sigma_tau)  # sigma tau < 0.5 here: no underflow
+    h = decay * tsinc
+    g = decay * (np.cos(theta) + (zeta * omega) * tsinc)
+    S, R = _step_ramp_series(omega * tau, 2.0 * sigma_tau, tau)
+    vv = st.vel[mode, seg]
+    out: list[np.ndarray | None] = []
+    for q in qs:
+        if q == 0:
+            out.append(st.eta[mode, seg] * g + vv * h + st.p[mode, seg] * S + st.s[mode, seg] * R)
+        elif q == 1:
+            out.append(vv * g + st.acc[mode, seg] * h + st.s[mode, seg] * S)
+        else:
+            out.append(None)
+    return out
 
 
 def _direct(st: _State, seg: np.ndarray, tau: np.ndarray, qs: tuple[int, ...]) -> np.ndarray:
@@ -559,9 +593,10 @@ def _evaluate(
     out[:, :, : int(np.searchsorted(t, st.starts[0], side="left"))] = 0.0  # before the force
     runs, rest = _runs(t, st.starts)
     scratch = None if project is None else np.empty((nq, m, min(_CHUNK, max(nt, 1))))
+    defer: list[tuple[int, np.ndarray, np.ndarray, np.ndarray]] = []
     for k, i0, i1 in runs:
         if project is None:
-            _table_run(st, k, t[i0:i1] - st.starts[k], qs, out[:, :, i0:i1])
+            _table_run(st, k, t[i0:i1] - st.starts[k], qs, out[:, :, i0:i1], defer, i0)
             continue
         assert scratch is not None
         for c0 in range(i0, i1, _CHUNK):
@@ -570,6 +605,17 @@ def _evaluate(
             _table_run(st, k, t[c0:c1] - st.starts[k], qs, buf)
             for iq in range(nq):  # 2-D products (BLAS), then one copy into the strided output
                 out[iq, :, c0:c1] = project @ buf[iq]
+    if defer:  # the small-omega-tau entries of every run, in one evaluation
+        seg_f, mode_f, col_f, tau_f = (
+            np.concatenate(x)
+            for x in zip(
+                *[(np.full(m_.size, k), m_, c_, t_) for k, m_, c_, t_ in defer], strict=True
+            )
+        )
+        vals_f = _small_tau_values(st, seg_f, mode_f, tau_f, qs)
+        for iq, v in enumerate(vals_f):
+            if v is not None:
+                out[iq][mode_f, col_f] = v
     seg_all = np.searchsorted(st.starts, t, side="right") - 1
     for c0 in range(0, rest.size, _CHUNK):
         idx = rest[c0 : c0 + _CHUNK]
