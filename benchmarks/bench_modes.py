@@ -8,7 +8,8 @@ Timed in one process, on the same matrices, for ``--modes`` 30 and 300 (rigid in
 with 1 and 2 BLAS threads (threadpoolctl):
 
 * ``microg.dynamics.modes.solve_modes``: exact rigid modes, the frame's exact tree
-  flexibility (no factorisation), ARPACK on ``G_e M``, inverse-form Rayleigh-Ritz, checks;
+  flexibility (no factorisation), ARPACK on ``G_e M`` (its inverse-form Ritz pairs,
+  M-orthonormalised), residual checks, effective masses;
 * baseline ``cholmod``: ``eigsh(K, k, M, sigma, OPinv=CHOLMOD(K - sigma M))`` with
   scikit-sparse's supernodal Cholesky (the best factorisation available; skipped with a note
   when scikit-sparse is not installed);

@@ -17,10 +17,12 @@ Method (the rigid span is never left to the eigensolver):
    ARPACK (``scipy.sparse.linalg.eigsh``, mode 3) runs on it in the M inner product; ``M``
    may be singular (massless coordinates: their directions have ``mu = 0``).  An unstable
    mode (a negative stiffness) is a negative ``mu``, found like the others.
-3. **Clean-up.**  A Rayleigh-Ritz step *in the inverse form* (``X^T M G_e M X``, not
-   ``X^T K X``, whose rounding ``eps |x|^T |K| |x|`` grows like ``(L/h)^4`` on fine meshes)
-   gives M-orthonormal shapes; every residual ``||K phi - w^2 M phi|| / || |K| |phi| ||`` is
-   checked.
+3. **Clean-up.**  The eigenvalues are Ritz values *in the inverse form* (ARPACK's, of
+   ``G_e M``; not ``X^T K X``, whose rounding ``eps |x|^T |K| |x|`` grows like ``(L/h)^4``
+   on fine meshes) and the shapes are made M-orthonormal (Gram-Schmidt, ascending); after
+   the block fallback, or with massless coordinates, an inverse-form Rayleigh-Ritz step
+   (``X^T M G_e M X``) gives the pairs.  Every residual
+   ``||K phi - w^2 M phi|| / || |K| |phi| ||`` is checked.
 4. **Mechanisms.**  With the generic inverse, a mode whose eigenvalue is within the rounding
    bound ``eps |phi|^T |K| |phi|`` of its own energy is a zero-energy motion: a mechanism,
    refused naming the components it moves.  A frame tree has none by construction (every
