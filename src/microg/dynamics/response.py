@@ -439,10 +439,17 @@ def _table_run(
             1: (v0[rigid], p0[rigid], s0[rigid] / 2.0, np.zeros(rigid.size)),
             2: (p0[rigid], s0[rigid], np.zeros(rigid.size), np.zeros(rigid.size)),
         }
-        powers = np.stack([np.ones(n), tau, tau * tau, tau * tau * tau])  # (4, n)
-        for iq, q in enumerate(qs):
-            coef = np.stack(polys[q], axis=1)  # (r, 4)
-            dest[iq, rigid] = coef @ powers
+        powers = np.empty((4, n))
+        powers[0] = 1.0
+        powers[1] = tau
+        np.multiply(tau, tau, out=powers[2])
+        np.multiply(powers[2], tau, out=powers[3])
+        coef = np.concatenate([np.stack(polys[q], axis=1) for q in qs])  # (nq r, 4)
+        vals = (coef @ powers).reshape(nq, rigid.size, n)
+        if rigid[-1] - rigid[0] + 1 == rigid.size:  # a slice: no fancy-index scatter
+            dest[:, int(rigid[0]) : int(rigid[-1]) + 1] = vals
+        else:
+            dest[:, rigid] = vals
     if not el.size:
         return
     omega, zeta = st.omega[el], st.zeta[el]
