@@ -414,8 +414,10 @@ RESUBMIT = 3
 def _lost(exc: BaseException) -> bool:
     """True when a task failed because a worker (and the data it held) was lost."""
     from asyncio import CancelledError
+    from concurrent.futures import CancelledError as FutureCancelled  # distributed's base
 
-    return isinstance(exc, CancelledError | KeyError | OSError) or "lost" in str(exc).lower()
+    lost = (CancelledError, FutureCancelled, KeyError, OSError)
+    return isinstance(exc, lost) or "lost" in str(exc).lower()
 
 
 def _scatter(client: Any, data: Any, broadcast: bool) -> Any:
@@ -430,6 +432,11 @@ def _scatter(client: Any, data: Any, broadcast: bool) -> Any:
                 raise
             time.sleep(0.5 * (attempt + 1))
     raise AssertionError("unreachable")  # pragma: no cover
+
+
+def _alive(future: Any) -> bool:
+    """True when a scattered future's data is still held by the cluster."""
+    return getattr(future, "status", None) == "finished"
 
 
 def _distributed(runner: _Runner, client: Any, task_fn: TaskFn, threads: int) -> None:
@@ -451,6 +458,7 @@ def _distributed(runner: _Runner, client: Any, task_fn: TaskFn, threads: int) ->
     n_threads = max(1, sum(client.nthreads().values()))
     limit = IN_FLIGHT_PER_THREAD * n_threads
     meta: dict[str, tuple[str, tuple[int, int], Any, int]] = {}
+    held: list[Any] = []
     ac = as_completed()
 
     def solve(key: tuple[int, int], attempt: int) -> None:
@@ -480,9 +488,16 @@ def _distributed(runner: _Runner, client: Any, task_fn: TaskFn, threads: int) ->
                     raise
                 if kind == "basis":
                     solve(key, attempt + 1)
-                else:  # the data may be gone with the worker: scatter it again
-                    shared["plan"] = _scatter(client, plan, True)
-                    basis_f[key] = _scatter(client, bases[key], True)
+                else:  # the data may be gone with the worker: scatter again what is lost
+                    # (a future still alive is kept, so that the other tasks resubmitted on
+                    # it are not cancelled as "already forgotten"; replaced ones are held
+                    # until the sweep ends for the tasks still running on them)
+                    if not _alive(shared["plan"]):
+                        held.append(shared["plan"])
+                        shared["plan"] = _scatter(client, plan, True)
+                    if not _alive(basis_f[key]):
+                        held.append(basis_f[key])
+                        basis_f[key] = _scatter(client, bases[key], True)
                     submit(key, works, attempt + 1)
                 continue
             finally:
