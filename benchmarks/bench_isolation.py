@@ -9,8 +9,10 @@
    ``bench`` extra; skipped without it), the same recurrence with the same matrices.  Grids:
    uniform (the shared-map scan); 3 step lengths 0.5, 1, 2 ms in random order (commensurate:
    refined onto the uniform 0.5 ms grid, 2.3 x 10^6 fine steps, and the shared-map scan); 3
-   step lengths 0.5, 0.73, 1.1 ms (not commensurate: the general scan, one map per distinct
-   step).  On the commensurate grid the loop uses the exact step lengths 0.5, 1, 2 ms while
+   step lengths 0.5, 0.73, 1.1 ms in random order (not commensurate: the general scan, one map
+   per distinct step); 1 ms then 1.37 ms steps (two uniform runs: the shared-map scan on each,
+   the state carried).  On the commensurate grid the loop uses the exact step lengths 0.5, 1,
+   2 ms while
    ``t = cumsum(steps)`` has drifted from their multiples by ~1e-8 s of rounding; microg's
    refined grid keeps every sample within 4e-9 s of its given time, hence the ~4e-10 (of peak)
    difference between the two, at the rounding of the times, not of the method.
@@ -150,11 +152,13 @@ def main() -> None:
     t_uni = np.linspace(0.0, 1000.0, 1_000_001)
     t_non = np.cumsum(np.r_[0.0, rng.choice([5e-4, 1e-3, 2e-3], 999_999)])
     t_inc = np.cumsum(np.r_[0.0, rng.choice([5e-4, 7.3e-4, 1.1e-3], 999_999)])
+    t_pw = np.r_[0.0, np.cumsum(np.r_[np.full(500_000, 1e-3), np.full(499_999, 1.37e-3)])]
     print("\nexact FOH package response, 4 states, 10^6 samples (1 BLAS thread)")
     grids = (
         ("uniform", t_uni),
         ("steps 0.5/1/2 ms (commensurate)", t_non),
         ("steps 0.5/0.73/1.1 ms (general)", t_inc),
+        ("1 ms then 1.37 ms (two runs)", t_pw),
     )
     for label, t in grids:
         a = np.sin(1.02 * t) + 0.1 * np.sin(17.0 * t)

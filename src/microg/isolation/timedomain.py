@@ -21,8 +21,10 @@ acceleration and stroke).  A grid whose steps are all whole multiples of one fin
 steps of 0.5, 1 and 2 ms in any order) is refined onto that uniform fine grid, where the input
 is the same piecewise-linear function, and takes the shared-map scan too (at most
 ``_REFINE_AT_MOST`` fine steps per step, every sample kept within the rounding of its time, see
-:func:`_commensurate`); the samples are picked from it.  Any other grid takes
-:func:`~microg._scan.affine_scan` (the states, one map per distinct step).  Both are vectorised
+:func:`_commensurate`); the samples are picked from it.  On any other grid each run of at
+least ``_RUN_AT_LEAST`` equal steps takes the shared-map scan, the state carried exactly from
+run to run, and the steps between runs :func:`~microg._scan.affine_scan` (the states, one map
+per distinct step); a grid with fewer long runs is one ``affine_scan``.  Both are vectorised
 over blocks of about sqrt(N) steps, with no loop over samples.
 
 Initial condition: the package (and absorber) start at rest relative to the mount, ``z = z' = 0``
@@ -297,6 +299,67 @@ def _refine(
     return out
 
 
+#: equal steps in a row from this many on take the shared-map scan (the state carried exactly)
+_RUN_AT_LEAST = 256
+
+
+def _piecewise_scan(
+    Phi: NDArray[np.float64],
+    G1: NDArray[np.float64],
+    G2: NDArray[np.float64],
+    index: NDArray[np.intp],
+    inputs: NDArray[np.float64],
+    out_map: NDArray[np.float64],
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Outputs ``out_map x`` (package acceleration, stroke) on a grid of several step lengths.
+
+    Every run of at least :data:`_RUN_AT_LEAST` equal steps is one time-invariant stretch:
+    :func:`~microg._scan.lti_scan` with the state carried in from the previous stretch (its
+    outputs include the state, so the next stretch starts from the exact end state).  The steps
+    between such runs take :func:`~microg._scan.affine_scan` (one map per distinct step) from
+    the state reached.  When the runs cover less than half the steps, the whole grid is one
+    :func:`~microg._scan.affine_scan`.
+    """
+    K, n = index.size, Phi.shape[-1]
+    bounds = np.r_[0, np.flatnonzero(np.diff(index)) + 1, K]
+    lengths = np.diff(bounds)
+    long = np.flatnonzero(lengths >= _RUN_AT_LEAST)
+    if 2 * int(lengths[long].sum()) < K:
+        offsets = G1[index] * inputs[:, :1] + G2[index] * inputs[:, 1:]
+        X = affine_scan(Phi, offsets, index=index)
+        return X @ out_map[0], X[:, 0]
+    full_map = np.vstack([out_map, np.eye(n)])  # the outputs, then the state
+    Y = np.empty((K + 1, out_map.shape[0]))
+    x = np.zeros(n)
+    Y[0] = out_map @ x
+    pos = 0
+    for r in long:
+        for i0, i1, lti in (
+            (pos, int(bounds[r]), False),
+            (int(bounds[r]), int(bounds[r + 1]), True),
+        ):
+            if i1 == i0:
+                continue
+            if lti:
+                u = int(index[i0])
+                Z = lti_scan(Phi[u], np.stack([G1[u], G2[u]]), inputs[i0:i1], full_map, x0=x)
+                Y[i0 + 1 : i1 + 1] = Z[1:, : out_map.shape[0]]
+                x = Z[-1, out_map.shape[0] :]
+            else:
+                idx = index[i0:i1]
+                offsets = G1[idx] * inputs[i0:i1, :1] + G2[idx] * inputs[i0:i1, 1:]
+                X = affine_scan(Phi, offsets, index=idx, x0=x)
+                Y[i0 + 1 : i1 + 1] = X[1:] @ out_map.T
+                x = X[-1]
+        pos = int(bounds[r + 1])
+    if pos < K:
+        idx = index[pos:]
+        offsets = G1[idx] * inputs[pos:, :1] + G2[idx] * inputs[pos:, 1:]
+        X = affine_scan(Phi, offsets, index=idx, x0=x)
+        Y[pos + 1 :] = X[1:] @ out_map.T
+    return Y[:, 0], Y[:, 1]
+
+
 @dataclass
 class IsolationTimeResponse:
     """Mount and package acceleration histories and their peak/RMS reduction.
@@ -396,10 +459,7 @@ def package_response(
         pick = np.r_[0, np.cumsum(counts)]  # fine index of every input sample
         y, stroke = Y[pick, 0], Y[pick, 1]
     else:
-        offsets = G1[index] * inputs[:, :1] + G2[index] * inputs[:, 1:]
-        X = affine_scan(Phi, offsets, index=index)
-        y = X @ C[0]
-        stroke = X[:, 0]
+        y, stroke = _piecewise_scan(Phi, G1, G2, index, inputs, out_map)
     peak_mount = float(np.max(np.abs(a0)))
     peak_package = float(np.max(np.abs(y)))
     rms_mount = _rms(t, a0)
