@@ -54,3 +54,22 @@ def test_recommended_mount_verified_in_time_domain() -> None:
     acc = res.responses["keel-tip"].acceleration
     pkg = np.array([package_response(rule, res.timepts, row).package_accel for row in acc])
     assert not assess(res.timepts, pkg, iss_requirement()).complies
+
+
+def test_undamped_resonance_exactly_on_a_bin_is_margin_zero_not_a_warning() -> None:
+    # an undamped mount (zeta 0) whose natural frequency is exactly a PSD bin with power has
+    # an unbounded response there (|T| = 1 / |1 - r^2| at r = 1): it must be judged margin 0,
+    # never a candidate, without a divide-by-zero (pytest runs with warnings as errors)
+    from microg.environment.metrics import Spectrum
+    from microg.environment.requirements import iss_requirement
+    from microg.isolation.mount import search_mount
+
+    df = 0.01
+    f = np.arange(0, 20001) * df
+    psd = np.full((3, f.size), 1e-14)
+    spec = Spectrum(f, psd, df, f[-1], "periodogram")
+    mass = 450.0
+    k_on_bin = mass * (2 * np.pi * 1.0) ** 2  # f_n = 1.00 Hz, bin 100
+    choice = search_mount(spec, iss_requirement(), mass, k_on_bin, zetas=(0.0,), decades=0.0, n_k=1)
+    assert choice.k1 == k_on_bin
+    assert choice.min_margin == 0.0 and not choice.found

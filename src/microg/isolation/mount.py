@@ -164,7 +164,17 @@ def search_mount(
     for zeta1 in zetas:
         for k1 in k_grid:
             c1 = 2 * zeta1 * np.sqrt(k1 * mass)
-            t2 = np.abs(mount_transmissibility(k1, c1, mass, omega)) ** 2
+            with np.errstate(divide="ignore", invalid="ignore"):
+                t2 = np.abs(mount_transmissibility(k1, c1, mass, omega)) ** 2
+            power = np.any(np.atleast_2d(spectrum.psd) > 0, axis=0)
+            if not np.all(np.isfinite(t2[power])):
+                # an undamped mount's resonance exactly on a bin carrying power: an
+                # unbounded response, margin 0 (never a candidate)
+                cand = (False, 0.0, k1, zeta1, c1, 0.0)
+                if best is None or cand[:2] > best[:2]:
+                    best = cand
+                continue
+            t2 = np.where(np.isfinite(t2), t2, 0.0)  # bins without power
             spec = Spectrum(
                 spectrum.freq_hz, spectrum.psd * t2, spectrum.df_hz, spectrum.nyquist_hz, "screen"
             )
