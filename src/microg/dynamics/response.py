@@ -529,9 +529,9 @@ def _table_run(
             if defer is not None:
                 defer.append((k, el[rows_f], cols_f + offset, tau[cols_f]))
             else:
-                vals = _small_tau_values(st, np.full(total, k), el[rows_f], tau[cols_f], qs)
+                small = _small_tau_values(st, np.full(total, k), el[rows_f], tau[cols_f], qs)
                 for iq in fix:
-                    target[iq][rows_f, cols_f] = vals[iq]
+                    target[iq][rows_f, cols_f] = small[iq]
     if not contiguous:
         dest[:, el] = target
 
