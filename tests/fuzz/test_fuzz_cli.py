@@ -390,9 +390,9 @@ def test_fuzz_command_lines(case: dict[str, Any]) -> None:
         raise AssertionError(f"{case['argv']}: exit {rc}, stderr {err!r}")
     data = json.loads(out)
     if case["argv"][0] == "isolate":
-        assert data["mass"] == pytest.approx(case["mass"], rel=1e-12)
+        assert data["mass_kg"] == pytest.approx(case["mass"], rel=1e-12)
         assert data["omega_band"][0] == pytest.approx(case["omega"], rel=1e-12)
-        assert math.isfinite(data["k1"]) and data["k1"] > 0
+        assert math.isfinite(data["k1_N_per_m"]) and data["k1_N_per_m"] > 0
     record("cli", "valid result")
 
 

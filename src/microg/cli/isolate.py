@@ -224,7 +224,7 @@ def design(
         )
     res = design_mount(m1, band, target, mu=mu, zeta=zeta)
     if as_json:
-        click.echo(dumps(res))
+        click.echo(dumps(res.to_dict()))
         return
     click.echo(f"package mass          {res.mass:.6g} kg ({res.mass * G0 * _LBF_PER_N:.6g} lbf)")
     click.echo(f"disturbance band      {band[0]:.6g} .. {band[1]:.6g} rad/s")
@@ -260,7 +260,7 @@ def claims(mu_max: float, as_json: bool) -> None:
 
     res = check_section42_claims(mu_max=mu_max)
     if as_json:
-        click.echo(dumps(res))
+        click.echo(dumps(res.to_dict()))
         return
     for c in res.checks:
         verdict = "HOLDS" if c.holds else "DOES NOT HOLD"
