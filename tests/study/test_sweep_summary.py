@@ -101,3 +101,15 @@ def test_to_dict_is_json_ready(result) -> None:
     d = result.to_dict()
     text = dumps(d)
     assert '"cases"' in text and d["cases"] == result.study.n_cases
+
+
+def test_summary_to_xarray_and_plot(result) -> None:
+    # reference: the dataset's own reduction (xarray), as test_heatmap_is_... does
+    ds = result.dataset.load()
+    s = result.summary(heatmap=("at", "observe"))
+    hx = s.to_xarray()
+    ref = ds.margin.where(ds.computed).min([d for d in CASE_DIMS if d not in ("at", "observe")])
+    np.testing.assert_array_equal(hx.margin.values, ref.transpose("at", "observe").values)
+    assert hx.margin.attrs["units"] == "1" and hx.attrs["cases"] == s.cases
+    assert list(hx.observe.values) == [str(o) for o in ref.observe.values]
+    assert isinstance(s.plot(), Figure)

@@ -109,6 +109,41 @@ class Summary:
             "dataset": None if self.out is None else f"{self.out}/results.zarr",
         }
 
+    def to_xarray(self) -> Any:
+        """The heat map as an ``xarray.Dataset``: ``margin`` over its two axes (NaN: no case)."""
+        import xarray as xr
+
+        d0, d1 = self.heatmap_dims
+        l0, l1 = (list(x) for x in self.heatmap_labels)
+        return xr.Dataset(
+            {
+                "margin": (
+                    (d0, d1),
+                    np.asarray(self.heatmap, float),
+                    {
+                        "units": "1",
+                        "long_name": "worst margin (limit / band RMS) over every other axis",
+                    },
+                )
+            },
+            coords={d0: [str(v) for v in l0], d1: [str(v) for v in l1]},
+            attrs={
+                "cases": int(self.cases),
+                "planned": int(self.planned),
+                "complying": int(self.complying),
+                "complying_fraction": float("nan")
+                if self.complying_fraction is None
+                else float(self.complying_fraction),
+                "requirement": self.requirement,
+            },
+        )
+
+    def plot(self) -> Any:
+        """The heat map of the worst margins (:func:`microg.plotting.study.heatmap_figure`)."""
+        from microg.plotting.study import heatmap_figure
+
+        return heatmap_figure(self)
+
 
 def _num(v: float) -> float | str | None:
     if np.isnan(v):
