@@ -414,3 +414,24 @@ def test_bare_numbers_take_the_models_unit_system():
     assert si.unit_system is None
     with pytest.raises(microg.InputError, match="no unit"):
         microg.analyze(si, force="crew-pushoff:f0=25", duration="100 s")
+
+
+def test_results_as_xarray_carry_units_and_the_same_numbers():
+    # reference: the result objects' own arrays (to_xarray is a relabelling, bit for bit)
+    import microg
+
+    r = microg.analyze("ioc", observe=["lab", "crew"], duration="50 s", dt="0.02 s")
+    ds = r.to_xarray()
+    assert list(ds.point.values) == ["lab", "crew"]
+    for i, name in enumerate(("lab", "crew")):
+        ob = r.observations[name]
+        np.testing.assert_array_equal(ds.accel_mps2.values[i], ob.response.acceleration)
+        assert ds.peak_accel_g.values[i] == ob.assessment.peak_accel_g
+        da = ob.to_xarray()
+        assert da.name == "accel_mps2" and da.attrs["units"] == "m/s^2"
+        assert da.time.attrs["units"] == "s"
+        c = ob.contributions.to_xarray()
+        np.testing.assert_array_equal(c.at_peak_g.values, ob.contributions.at_peak_g)
+        assert c.freq_hz.attrs["units"] == "Hz"
+    np.testing.assert_array_equal(ds.time.values, r.timepts)
+    assert ds.accel_mps2.attrs["units"] == "m/s^2" and ds.time.attrs["units"] == "s"

@@ -319,6 +319,9 @@ def test_advice_not_needed_still_plots():
 
 #: public result types and the methods they have; a type missing here fails the inventory
 CONTRACT: dict[str, tuple[str, ...]] = {
+    "microg.analysis.Analysis": ("to_dict", "to_xarray", "plot"),
+    "microg.analysis.Observation": ("to_dict", "to_xarray", "plot"),
+    "microg.analysis.ModeContributions": ("to_dict", "to_xarray"),
     "microg.study.summary.Summary": ("to_dict", "to_xarray", "plot"),
     # environment
     "microg.environment.metrics.Spectrum": ("to_dict", "to_xarray", "plot"),
@@ -403,7 +406,6 @@ KNOWN_GAPS: dict[str, tuple[str, ...]] = {
     "microg.dynamics.response.PointResponse": ("to_dict", "to_xarray", "plot"),
     "microg.dynamics.response.PeakResponse": ("to_xarray",),
     "microg.isolation.timedomain.IsolationTimeResponse": ("to_dict", "to_xarray", "plot"),
-    "microg.analysis.Analysis": ("to_xarray",),
 }
 
 _STAGES = ("environment", "isolation", "location", "dynamics", "study")

@@ -221,6 +221,28 @@ class ModeContributions:
             rows.append(row)
         return {"worst_band_hz": self.worst_band_hz, "worst_axis": self.worst_axis, "modes": rows}
 
+    def to_xarray(self) -> Any:
+        """The table as an ``xarray.Dataset`` over ``mode`` (g; ``freq_hz`` a coordinate)."""
+        import xarray as xr
+
+        data: dict[str, Any] = {
+            "at_peak_g": ("mode", self.at_peak_g, {"units": "g"}),
+            "own_peak_g": ("mode", self.own_peak_g, {"units": "g"}),
+        }
+        if self.worst_band_rms_g is not None:
+            data["worst_band_rms_g"] = ("mode", self.worst_band_rms_g, {"units": "g"})
+        attrs: dict[str, Any] = {"worst_axis": self.worst_axis or ""}
+        if self.worst_band_hz is not None:
+            attrs["worst_band_hz"] = float(self.worst_band_hz)
+        return xr.Dataset(
+            data,
+            coords={
+                "mode": ("mode", self.mode, {"units": "1"}),
+                "freq_hz": ("mode", self.freq_hz, {"units": "Hz"}),
+            },
+            attrs=attrs,
+        )
+
 
 @dataclass(frozen=True)
 class Observation:
@@ -275,16 +297,19 @@ class Observation:
         return d
 
     def to_xarray(self) -> Any:
-        """The acceleration history as an ``xarray.DataArray`` (dims axis, time; m/s^2)."""
+        """The acceleration history as an ``xarray.DataArray`` ``accel_mps2`` (axis, time)."""
         import xarray as xr
 
         r = self.response
         return xr.DataArray(
             r.acceleration,
             dims=("axis", "time"),
-            coords={"axis": ["x", "y", "z"], "time": r.timepts},
-            name="acceleration",
-            attrs={"units": "m/s^2", "point": self.name, "time_units": "s"},
+            coords={
+                "axis": ["x", "y", "z"],
+                "time": ("time", r.timepts, {"units": "s"}),
+            },
+            name="accel_mps2",
+            attrs={"units": "m/s^2", "point": self.name, "long_name": "acceleration"},
         )
 
     def plot(self) -> Figure:
@@ -401,6 +426,47 @@ class Analysis:
         if fd is None:
             return {}
         return {"frequency_domain": fd.to_dict(), "frequency_domain_basis": fd.info_dict()}
+
+    def to_xarray(self) -> Any:
+        """Every observed point's acceleration history in one ``xarray.Dataset``.
+
+        ``accel_mps2`` over (point, axis, time), m/s^2, and the verdict numbers per point
+        (``peak_accel_g``, ``complies``); the model, requirement and warnings in the attributes.
+        """
+        import xarray as xr
+
+        names = list(self.observations)
+        obs = [self.observations[n] for n in names]
+        acc = (
+            np.stack([o.response.acceleration for o in obs])
+            if obs
+            else np.zeros((0, 3, self.timepts.size))
+        )
+        return xr.Dataset(
+            {
+                "accel_mps2": (("point", "axis", "time"), acc, {"units": "m/s^2"}),
+                "peak_accel_g": (
+                    "point",
+                    np.array([o.assessment.peak_accel_g for o in obs], float),
+                    {"units": "g"},
+                ),
+                "complies": (
+                    "point",
+                    np.array([bool(o.assessment.complies) for o in obs], bool),
+                    {"units": "1"},
+                ),
+            },
+            coords={
+                "point": names,
+                "axis": ["x", "y", "z"],
+                "time": ("time", self.timepts, {"units": "s"}),
+            },
+            attrs={
+                "model": self.model,
+                "requirement": str(getattr(self.requirement, "name", "")),
+                "warnings": "\n".join(self.warnings),
+            },
+        )
 
     def plot(self) -> Figure:
         """The modes used and the peak at each observed point (a Figure)."""
