@@ -85,6 +85,7 @@ class MovableType(click.ParamType):
     name = "NAME=LO:HI"
 
     def convert(self, value: Any, param: Any, ctx: Any) -> tuple[str, str, str]:
+        """``(name, lo, hi)`` texts of ``NAME=LO:HI``; a tuple passes through."""
         from microg.location.layout import parse_movable
 
         if isinstance(value, tuple):
@@ -101,6 +102,7 @@ class CarryType(click.ParamType):
     name = "POINT=MASS"
 
     def convert(self, value: Any, param: Any, ctx: Any) -> tuple[str, str]:
+        """``(point, mass)`` texts of ``POINT=MASS``; a tuple passes through."""
         if isinstance(value, tuple):
             return value
         text = str(value)

@@ -43,9 +43,11 @@ class QuantityType(click.ParamType):
         self.maximum = LIMITS[dimension] if maximum is None else maximum
 
     def get_metavar(self, param: click.Parameter, ctx: click.Context | None = None) -> str:
+        """The help's placeholder: ``Q``, or ``Q[unit]`` with the default unit."""
         return "Q" if self.default_unit is None else f"Q[{self.default_unit}]"
 
     def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
+        """The SI value of ``value`` (a float passes through), checked against the bounds."""
         if isinstance(value, float):
             return value
         try:
@@ -79,9 +81,11 @@ class MassOrWeightType(click.ParamType):
         self.default_unit = default_unit
 
     def get_metavar(self, param: click.Parameter, ctx: click.Context | None = None) -> str:
+        """The help's placeholder, ``Q[unit]`` with the default unit."""
         return f"Q[{self.default_unit}]"
 
     def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
+        """The mass of ``value``, kg (a weight divided by g0; a float passes through)."""
         if isinstance(value, float):
             return value
         errors = []
@@ -121,6 +125,7 @@ class PositiveFloat(click.ParamType):
         self.strict = strict
 
     def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
+        """The finite float of ``value``, checked against the lower bound."""
         try:
             x = float(value)
         except (TypeError, ValueError):
@@ -143,6 +148,7 @@ class RangeType(click.ParamType):
         self.max_points = max_points
 
     def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
+        """``(start, stop, n)`` of ``START:STOP:N``, in the option's unit; a tuple passes."""
         if isinstance(value, tuple):
             return value
         parts = str(value).split(":")
@@ -171,6 +177,7 @@ class BandType(click.ParamType):
     name = "LO:HI"
 
     def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
+        """``(lo, hi)`` of ``LO:HI``, in the option's unit (Hz, rad/s); a tuple passes through."""
         if isinstance(value, tuple):
             return value
         parts = str(value).split(":")

@@ -81,12 +81,12 @@ def sweep(
     as_json: bool,
     no_progress: bool,
 ) -> None:
-    """Every case of STUDY.toml (forces x points x directions x observed points x damping x
-    isolators x model variants), by linearity: one modal solve per model variant.
+    """Every case of STUDY.toml, by linearity: one modal solve per model variant.
 
-    Writes OUT/results.zarr (an xarray Dataset, one dimension per axis) as it goes and
-    OUT/report.html (worst cases, margin heat map, complying fraction, and the microg analyze
-    command that reproduces any case).
+    The cases are forces x points x directions x observed points x damping x isolators x
+    model variants.  Writes OUT/results.zarr (an xarray Dataset, one dimension per axis) as it
+    goes and OUT/report.html (worst cases, margin heat map, complying fraction, and the microg
+    analyze command that reproduces any case).
     """
     from tqdm import tqdm
 

@@ -1,5 +1,7 @@
-"""Frequency-domain response of a modal model (the SOL 111 equivalent): FRFs, harmonic lines,
-band RMS of force spectra, combination over sources, modal and source contributions.
+"""Frequency-domain response of a modal model (the SOL 111 equivalent).
+
+FRFs, harmonic lines, band RMS of force spectra, combination over sources, modal and source
+contributions.
 
 Conventions (SI; frequencies in Hz where named ``_hz``, circular frequencies ``omega`` in rad/s)
 

@@ -206,8 +206,10 @@ class MeasuredRecord:
         }
 
     def to_xarray(self) -> Any:
-        """The samples as an ``xarray.DataArray`` ``accel_mps2`` (dims ``axis``, ``time``;
-        m/s^2, times in s), the header in the attributes."""
+        """The samples as an ``xarray.DataArray`` ``accel_mps2``, the header in the attributes.
+
+        Dims ``axis``, ``time``; m/s^2, times in s.
+        """
         import xarray as xr
 
         return xr.DataArray(
@@ -500,8 +502,11 @@ def _scan_bad_line(lines: list[str], start: int, ncol: int, path: str) -> InputE
 
 
 def _nonuniform_step(t: np.ndarray) -> tuple[int, float, float] | None:
-    """``(i, step, typical)`` of the first step off the typical one by more than
-    :data:`CSV_STEP_TOLERANCE` (``i``: 0-based index of the sample after it), else None."""
+    """``(i, step, typical)`` of the first time step off the typical one, else None.
+
+    Off: by more than :data:`CSV_STEP_TOLERANCE`; ``i`` is the 0-based index of the sample
+    after it.
+    """
     steps = np.diff(t)
     typical = float(np.median(steps))  # robust: a single gap does not move it
     off = np.abs(steps - typical) > CSV_STEP_TOLERANCE * abs(typical)

@@ -386,8 +386,10 @@ class IntegratedAcceleration:
     )
 
     def to_dict(self, axes: tuple[str, ...] | None = None) -> dict[str, Any]:
-        """JSON-ready summary: the window and the largest integrals, m/s (no per-window rows;
-        those are in :meth:`to_xarray`)."""
+        """JSON-ready summary: the window and the largest integrals, m/s.
+
+        No per-window rows; those are in :meth:`to_xarray`.
+        """
         ax = axis_names(self.delta_v.shape[0], axes)
         return {
             "definition": self.DEFINITION,
@@ -398,8 +400,10 @@ class IntegratedAcceleration:
         }
 
     def to_xarray(self, axes: tuple[str, ...] | None = None) -> Any:
-        """The integral of each window as an ``xarray.Dataset``: ``delta_v_mps`` on dims
-        ``axis``, ``t_start_s``."""
+        """The integral of each window as an ``xarray.Dataset``.
+
+        ``delta_v_mps`` on dims ``axis``, ``t_start_s``.
+        """
         ax = axis_names(self.delta_v.shape[0], axes)
         return _dataset(
             {
@@ -458,8 +462,10 @@ class IntegratedBlocks:
     )
 
     def to_dict(self, axes: tuple[str, ...] | None = None) -> dict[str, Any]:
-        """JSON-ready summary: the window and the largest integrals, m/s (no per-window rows;
-        those are in :meth:`to_xarray`)."""
+        """JSON-ready summary: the window and the largest integrals, m/s.
+
+        No per-window rows; those are in :meth:`to_xarray`.
+        """
         ax = axis_names(self.delta_v.shape[0], axes)
         return {
             "definition": self.DEFINITION,
@@ -471,8 +477,10 @@ class IntegratedBlocks:
         }
 
     def to_xarray(self, axes: tuple[str, ...] | None = None) -> Any:
-        """The integral of each window as an ``xarray.Dataset``: ``delta_v_mps`` on dims
-        ``axis``, ``t_start_s``."""
+        """The integral of each window as an ``xarray.Dataset``.
+
+        ``delta_v_mps`` on dims ``axis``, ``t_start_s``.
+        """
         ax = axis_names(self.delta_v.shape[0], axes)
         return _dataset(
             {

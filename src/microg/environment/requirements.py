@@ -60,8 +60,10 @@ class BandTable:
         }
 
     def to_xarray(self) -> Any:
-        """The bands as an ``xarray.Dataset``: dim ``center_hz``, edges as coordinates, and
-        ``width_hz`` (upper - lower) as the data variable."""
+        """The bands as an ``xarray.Dataset`` on dim ``center_hz``.
+
+        The edges are coordinates, and ``width_hz`` (upper - lower) is the data variable.
+        """
         import xarray as xr
 
         return xr.Dataset(

@@ -250,8 +250,11 @@ class VibratoryAssessment:
         return out
 
     def plot(self, point: str | None = None, kind: str = "bands") -> Any:
-        """Figure: ``bands`` (band RMS per axis against the limit) or ``contributions``
-        (each source's share of the governing axis per band)."""
+        """Figure: ``bands`` or ``contributions``.
+
+        ``bands``: band RMS per axis against the limit; ``contributions``: each source's
+        share of the governing axis per band.
+        """
         from microg.plotting.frequency import plot_contributions, plot_vibratory
 
         if kind == "bands":

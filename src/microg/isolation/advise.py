@@ -115,8 +115,10 @@ class IsolationAdvice:
         return cls(point, "not-assessed", note="isolation not assessed")
 
     def freq_hz(self) -> np.ndarray:
-        """Frequencies for the mounts' curves, Hz: the design's and the screened mount's grids
-        joined (empty when neither exists)."""
+        """Frequencies for the mounts' curves, Hz.
+
+        The design's and the screened mount's grids joined (empty when neither exists).
+        """
         grids = [m.default_freq_hz() for m in (self.design, self.mount) if m is not None]
         return np.unique(np.concatenate(grids)) if grids else np.zeros(0)
 

@@ -119,8 +119,10 @@ class MountDesign:
         return accel_magnification(self.k, self.mu, self.zeta, r)
 
     def default_freq_hz(self) -> np.ndarray:
-        """801 log-spaced frequencies from f_n / 20 to 5 times the band's top, with the band
-        edges, Hz."""
+        """801 log-spaced frequencies from f_n / 20 to 5 times the band's top, Hz.
+
+        The band edges are included.
+        """
         lo, hi = self.band_hz
         grid = np.geomspace(self.freq_hz_n / 20, max(5 * hi, 20 * self.freq_hz_n), 801)
         return np.unique(np.r_[grid, lo, hi])

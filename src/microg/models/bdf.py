@@ -145,13 +145,16 @@ class Card:
 
     @property
     def where(self) -> str:
+        """``FILE:LINE: NAME ID`` of the card, for error messages."""
         ident = self.raw(1)
         return f"{self.file}:{self.line}: {self.name}" + (f" {ident}" if ident is not None else "")
 
     def error(self, what: str, fix: str | None = None) -> InputError:
+        """An :class:`~microg.errors.InputError` at this card (:attr:`where`)."""
         return InputError(what, where=self.where, fix=fix)
 
     def integer(self, i: int, label: str, default: Any = ...) -> int:
+        """Integer field ``i`` (``label`` in messages); blank: ``default`` or an error."""
         v = self.raw(i)
         if v is None:
             if default is ...:
@@ -162,6 +165,7 @@ class Card:
         return v
 
     def real(self, i: int, label: str, default: Any = ...) -> float:
+        """Real field ``i`` as written (an integer is accepted); blank: ``default`` or an error."""
         v = self.raw(i)
         if v is None:
             if default is ...:
@@ -172,6 +176,7 @@ class Card:
         return float(v)
 
     def text(self, i: int, label: str, default: Any = ...) -> str:
+        """Field ``i`` as text (``label`` in messages); blank: ``default`` or an error."""
         v = self.raw(i)
         if v is None:
             if default is ...:

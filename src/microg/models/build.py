@@ -66,6 +66,7 @@ class Builder:
 
     # ----- helpers
     def error(self, path: str, what: str, fix: str | None = None) -> ModelError:
+        """A :class:`~microg.errors.ModelError` at ``FILE: path``."""
         return ModelError(what, where=f"{self.file}: {path}" if path else self.file, fix=fix)
 
     def q(self, value: str | float, kind: str, path: str) -> float:
@@ -117,10 +118,12 @@ class Builder:
         return out
 
     def vec(self, value: Sequence[str | float], path: str) -> np.ndarray:
+        """A position (3,), m: each component parsed as a length."""
         return np.array([self.q(c, "position", f"{path}[{i}]") for i, c in enumerate(value)])
 
     # ----- the whole file
     def build(self) -> Station:
+        """The checked SI :class:`~microg.models.station.Station` of the whole file."""
         doc = self.doc
         st = doc.station
         gravity = (
@@ -226,6 +229,7 @@ class Builder:
         )
 
     def orbit(self) -> Orbit:
+        """The orbit from exactly one of radius or altitude (m), with ``mu`` (m^3/s^2) if given."""
         o = self.doc.orbit
         if (o.radius is None) == (o.altitude is None):
             what = (
@@ -249,6 +253,7 @@ class Builder:
         return Orbit(radius=radius, mu=mu)
 
     def check_names(self) -> None:
+        """Check that component, point and per-component mass names are unique."""
         doc = self.doc
         seen: dict[str, str] = {}
         comps = [(f"body[{i}].name", b.name) for i, b in enumerate(doc.body)]
@@ -289,6 +294,7 @@ class Builder:
                     seen[m.name] = path
 
     def beam_geometry(self, i: int, b: BeamIn) -> dict[str, Any]:
+        """SI geometry, stiffness (N m^2, N) and mass per length (kg/m) of beam ``i``."""
         p = f"beam[{i}]"
         root = self.vec(b.root, f"{p}.root")
         direction = np.asarray(b.direction, float)
@@ -364,6 +370,7 @@ class Builder:
         }
 
     def check_parents(self) -> None:
+        """Check the attachments: the root first, bodies on beams with ``at``, parents known."""
         doc = self.doc
         known = ", ".join(self.kind)
         b0 = doc.body[0]
@@ -500,6 +507,7 @@ class Builder:
         )
 
     def inertia(self, path: str, raw: InertiaIn | None) -> np.ndarray:
+        """The inertia tensor (3, 3), kg m^2, positive semidefinite (zeros when none is given)."""
         if raw is None:
             return np.zeros((3, 3))
         p = f"{path}.inertia"
@@ -528,6 +536,7 @@ class Builder:
         coord: float,
         span: tuple[float, float] | None,
     ) -> tuple[float, float] | None:
+        """The movable range ``(lo, hi)``, m, holding ``coord`` and within ``span``."""
         if raw is None:
             return None
         p = f"{path}.movable"
@@ -559,6 +568,7 @@ class Builder:
         return (lo, hi)
 
     def body_mass(self, path: str, m: BodyMassIn) -> PointMass:
+        """A point mass on a body: mass (kg), position (m), inertia (kg m^2), movable range."""
         inertia = self.inertia(path, m.inertia)
         mass = self.mass_value(path, m, inertia)
         pos = self.vec(m.at, f"{path}.at")
@@ -573,6 +583,7 @@ class Builder:
         )
 
     def beam_mass(self, path: str, m: BeamMassIn, beam: Beam) -> PointMass:
+        """A point mass on ``beam`` at arc length ``s`` or at ``at`` (m), snapped to its axis."""
         if (m.s is None) == (m.at is None):
             raise self.error(
                 path,
@@ -597,6 +608,7 @@ class Builder:
         )
 
     def point(self, i: int, p: PointIn, beams: dict[str, Beam]) -> NamedPoint:
+        """Named point ``i`` at its position (m), on a body or snapped to its beam's axis."""
         path = f"point[{i}]"
         kind = self.kind.get(p.on)
         if kind is None:

@@ -219,13 +219,18 @@ class CoordSystem:
     axes: np.ndarray
 
     def to_basic(self, x: np.ndarray) -> np.ndarray:
-        """Basic positions (n, 3) of coordinates ``x`` (n, 3) given in this system
-        (R: x, y, z; C: r, theta deg, z; S: r, theta deg, phi deg)."""
+        """Basic positions (n, 3) of coordinates ``x`` (n, 3) given in this system.
+
+        R: x, y, z; C: r, theta deg, z; S: r, theta deg, phi deg.
+        """
         return self.origin + _local_rect(self.kind, np.asarray(x, float)) @ self.axes.T
 
     def directions(self, xyz_basic: np.ndarray) -> np.ndarray:
-        """Output directions (n, 3, 3) at basic points: columns are the unit vectors of the
-        system's components (x, y, z; r, theta, z; r, theta, phi) in basic."""
+        """Output directions (n, 3, 3) at basic points.
+
+        Columns are the unit vectors of the system's components (x, y, z; r, theta, z;
+        r, theta, phi) in basic.
+        """
         p = (np.asarray(xyz_basic, float) - self.origin) @ self.axes  # local rectangular
         n = p.shape[0]
         if self.kind == "R":
@@ -270,8 +275,10 @@ BASIC = CoordSystem(0, "R", np.zeros(3), np.eye(3))
 def cord2_system(
     cid: int, kind: str, a: np.ndarray, b: np.ndarray, c: np.ndarray, ref: CoordSystem
 ) -> CoordSystem:
-    """A CORD2R/C/S system from its points A (origin), B (on z), C (in the xz plane), given in
-    the reference system ``ref``."""
+    """A CORD2R/C/S system from its points A (origin), B (on z), C (in the xz plane).
+
+    The points are given in the reference system ``ref``.
+    """
     pa, pb, pc = ref.to_basic(np.array([a, b, c], float))
     ez = pb - pa
     if np.linalg.norm(ez) == 0:
@@ -911,8 +918,10 @@ def modal_model_from_op4(
     points: Sequence[ModalPoint] = (),
     n_modes: int | None = None,
 ) -> ModalModel:
-    """A :class:`ModalModel` from OP4 matrices: solve ``KAA phi = lambda MAA phi``, recover
-    grid motion through ``shapes`` (rows on ``dof_map``) or take the a-set itself.
+    """A :class:`ModalModel` from OP4 matrices.
+
+    Solves ``KAA phi = lambda MAA phi`` and recovers grid motion through ``shapes`` (rows on
+    ``dof_map``) or takes the a-set itself.
 
     Parameters
     ----------

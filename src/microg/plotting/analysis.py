@@ -1,5 +1,7 @@
-"""Figures of the main job: the model with its points and mode shapes, the forces, the modes,
-and each observed point's history and bands.  They read result objects only.
+"""Figures of the main job.
+
+The model with its points and mode shapes, the forces, the modes, and each observed point's
+history and bands.  They read result objects only.
 """
 
 from __future__ import annotations

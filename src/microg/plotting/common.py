@@ -59,8 +59,10 @@ _POWER = re.compile(r"\^\{(-?\d+)\}")
 
 
 class PlainLogFormatter(LogFormatterSciNotation):
-    """Log-axis labels as :class:`~matplotlib.ticker.LogFormatterSciNotation` writes them,
-    set in Unicode (``10⁻⁵``, ``2×10³``) instead of mathtext; same ticks, same text."""
+    """Log-axis labels as :class:`~matplotlib.ticker.LogFormatterSciNotation` writes them.
+
+    Set in Unicode (``10⁻⁵``, ``2×10³``) instead of mathtext; same ticks, same text.
+    """
 
     def __call__(self, x: float, pos: int | None = None) -> str:
         """The label of the tick at ``x``."""
@@ -210,8 +212,11 @@ def _char_em(c: str) -> float:
 
 
 class _MinorTicks(Artist):
-    """The minor ticks and grid lines of a log axis drawn as two artists instead of one
-    :class:`~matplotlib.axis.Tick` (five artists) per tick, styled as the axis' own ticks."""
+    """The minor ticks and grid lines of a log axis drawn as two artists.
+
+    Instead of one :class:`~matplotlib.axis.Tick` (five artists) per tick; styled as the
+    axis' own ticks.
+    """
 
     def __init__(self, ax: Any, axis: Any, locator: Any, grid: Any, mark: Any) -> None:
         super().__init__()

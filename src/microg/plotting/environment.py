@@ -93,8 +93,10 @@ def plot_psd(
 
 
 def _bands_on(ax: Any, to: ThirdOctave, axes: tuple[str, ...], style: str, label: str) -> None:
-    """Band RMS per axis, micro-g: a line through the centres, resolved bands filled, the
-    others hollow."""
+    """Band RMS per axis, micro-g.
+
+    A line through the centres, resolved bands filled, the others hollow.
+    """
     res = np.asarray(to.resolved, bool)
     line, marker = style[1:] or "-", style[0]
     for name, row in zip(axes, to.rms_g, strict=False):

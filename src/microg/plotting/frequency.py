@@ -1,5 +1,6 @@
-"""Figures of the frequency-domain analysis: FRFs, harmonic lines, band RMS, contributions,
-allocations.
+"""Figures of the frequency-domain analysis.
+
+FRFs, harmonic lines, band RMS, contributions, allocations.
 
 Figures are built with ``matplotlib.figure.Figure`` (no pyplot, no backend switch).
 """

@@ -1,6 +1,9 @@
-"""Isolation figures: Figure 8 of the report (``M_a`` against ``r^2``), an absorber's, a mount
-design's and a screened mount's curves, and the isolation advice.  They draw the numbers of the
-result objects' ``to_xarray()``; they compute nothing of their own."""
+"""Isolation figures.
+
+Figure 8 of the report (``M_a`` against ``r^2``), an absorber's, a mount design's and a
+screened mount's curves, and the isolation advice.  They draw the numbers of the result
+objects' ``to_xarray()``; they compute nothing of their own.
+"""
 
 from __future__ import annotations
 
@@ -122,8 +125,10 @@ def _log_axes(ax: Any, xlabel: str, ylabel: str) -> None:
 
 
 def plot_absorber(tuning: AbsorberTuning) -> Figure:
-    """``M_a`` of a tuned absorber against ``r = omega/omega_n``, the package alone dashed,
-    the design band shaded and the peak marked; returns a Figure."""
+    """``M_a`` of a tuned absorber against ``r = omega/omega_n``; returns a Figure.
+
+    The package alone dashed, the design band shaded and the peak marked.
+    """
     ds = tuning.to_xarray()
     r = ds["r"].values
     fig = new_figure(7.5, 4.2)
@@ -147,8 +152,10 @@ def plot_absorber(tuning: AbsorberTuning) -> Figure:
 
 
 def plot_mount_design(design: MountDesign) -> Figure:
-    """A mount design's ``M_a`` against support frequency (Hz), the disturbance band shaded
-    and the target drawn; returns a Figure."""
+    """A mount design's ``M_a`` against support frequency (Hz); returns a Figure.
+
+    The disturbance band shaded and the target drawn.
+    """
     ds = design.to_xarray()
     fig = new_figure(7.5, 4.2)
     ax = fig.add_subplot()
@@ -179,8 +186,11 @@ def plot_mount_choice(choice: MountChoice) -> Figure:
 
 
 def plot_isolation_advice(advice: IsolationAdvice) -> Figure:
-    """The largest ``M_a`` each exceeding band allows (1 / attenuation needed) against the
-    report-rule design's ``M_a`` and the screened mount's ``|U1/U0|``; returns a Figure."""
+    """The largest ``M_a`` each exceeding band allows against the mounts'; returns a Figure.
+
+    The allowed ``M_a`` is 1 / attenuation needed; the mounts' are the report-rule design's
+    ``M_a`` and the screened mount's ``|U1/U0|``.
+    """
     ds = advice.to_xarray()
     fig = new_figure(7.5, 4.2)
     ax = fig.add_subplot()

@@ -19,8 +19,9 @@ __all__ = ["render_reproduction", "environment", "id_ranges"]
 
 
 def id_ranges(ids: list[str]) -> list[tuple[str, str]]:
-    """Errata ids as (label, anchor) runs: ``["E9", "E10", "E11", "E14"]`` ->
-    ``[("E9-E11", "E9"), ("E14", "E14")]``.
+    """Errata ids as (label, anchor) runs.
+
+    ``["E9", "E10", "E11", "E14"]`` -> ``[("E9-E11", "E9"), ("E14", "E14")]``.
 
     Parameters
     ----------

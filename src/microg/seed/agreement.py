@@ -254,7 +254,7 @@ class Comparison:
 
     @property
     def rel_tolerance(self) -> float | None:
-        """tolerance / |printed| (None for a printed 0)."""
+        """Relative tolerance, ``tolerance / |printed|`` (None for a printed 0)."""
         return None if self.printed == 0 else self.tolerance / abs(self.printed)
 
     def to_dict(self) -> dict[str, Any]:

@@ -299,9 +299,12 @@ class Reproduction:
         return self.contract()
 
     def contract(self) -> dict:
-        """The ``--json`` contract: ``seed_report``, ``meta``, ``agreement``, ``comparisons``,
-        ``nomenclature``, then ``appendix_c`` and ``table4`` keyed by case, ``options``,
-        ``errata`` and ``model_mass_properties``."""
+        """The ``--json`` contract.
+
+        ``seed_report``, ``meta``, ``agreement``, ``comparisons``, ``nomenclature``, then
+        ``appendix_c`` and ``table4`` keyed by case, ``options``, ``errata`` and
+        ``model_mass_properties``.
+        """
         out: dict = {
             "seed_report": self.seed_report.to_dict(),
             "meta": self.meta,

@@ -1,5 +1,7 @@
-"""The seed report itself (title, what the OCR'd copy shows of its origin) and the provenance
-of a reproduction (version, time, command, the files the numbers come from, with sha256).
+"""The seed report itself and the provenance of a reproduction.
+
+The report: its title, what the OCR'd copy shows of its origin.  The provenance: version, time,
+command, the files the numbers come from, with sha256.
 
 The report is not shipped: its OCR'd copy lives beside the project (``../shared/seed/``).
 The values microg compares against were read from that copy into

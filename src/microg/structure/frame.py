@@ -862,7 +862,12 @@ def _element_transform(R: np.ndarray, off_a: np.ndarray, off_b: np.ndarray) -> n
 def _principal(
     R: np.ndarray, secs: list[BeamSection]
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Rotate local y, z to principal bending axes where I12 != 0; EI_y, EI_z, shear kept?"""
+    """Rotate local y, z to the principal bending axes of the sections where I12 != 0.
+
+    Returns the rotated frames ``R``, the principal ``EI_y``, ``EI_z`` (N m^2) and the indices
+    of the skew sections.  Shear is not handled here: the caller drops the shear flexibility
+    of the skew sections (NASTRAN ignores the shear factors when I12 != 0).
+    """
     ei_y = np.array([s.ei_y_N_m2 for s in secs])
     ei_z = np.array([s.ei_z_N_m2 for s in secs])
     ei_yz = np.array([s.ei_yz_N_m2 for s in secs])

@@ -712,8 +712,11 @@ def _rms(c: np.ndarray, gram_r: np.ndarray, nt: int) -> dict[str, np.ndarray]:
 
 
 def _band_rms(c: np.ndarray, group: ModalGroup, req: Requirement) -> np.ndarray:
-    """(cells, 3, nb) band RMS of the records ``c @ h``, m/s^2: the periodogram of each record
-    (``c @ X``, the DFT being linear) through the band rule :func:`band_rms`."""
+    """(cells, 3, nb) band RMS of the records ``c @ h``, m/s^2.
+
+    The periodogram of each record (``c @ X``, the DFT being linear) through the band rule
+    :func:`band_rms`.
+    """
     n = c.shape[0]
     g = group.grid
     out = np.empty((n, 3, group.center_hz.size))

@@ -1260,9 +1260,11 @@ def _move(model: Any, v: VariantItem, where: str) -> Any:
 
 
 def default_n_modes(study: Study) -> int | None:
-    """The modes a sparse model's solve asks for when the study names none: the analysis'
-    default, or its default with sources when the study has source catalogues (so that the
-    per-case path solves the same modes)."""
+    """The modes a sparse model's solve asks for when the study names none.
+
+    The analysis' default, or its default with sources when the study has source catalogues
+    (so that the per-case path solves the same modes).
+    """
     if not any(f.catalogue is not None for f in study.forces):
         return None
     from microg.analysis import DEFAULT_SOURCE_MODES

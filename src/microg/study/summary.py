@@ -161,8 +161,10 @@ def _sort_key(row: dict[str, Any]) -> tuple[float, float]:
 
 
 def default_heatmap(study: Study) -> tuple[str, str]:
-    """The heat map's axes when none are asked: at x observe when both vary, else the two
-    axes with the most values."""
+    """The heat map's axes when none are asked.
+
+    At x observe when both vary, else the two axes with the most values.
+    """
     sizes = dict(zip(CASE_DIMS, study.shape, strict=True))
     varying = [d for d in CASE_DIMS if sizes[d] > 1]
     if "at" in varying and "observe" in varying:
