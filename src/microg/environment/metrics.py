@@ -360,30 +360,19 @@ class ThirdOctave:
         return plot_bands(self, axes=axis_names(self.rms_g.shape[0], axes), title=title)
 
 
-@dataclass(frozen=True)
-class IntegratedAcceleration:
-    """Integral of the acceleration over sliding windows (velocity change), m/s.
+class _WindowIntegrals:
+    """The methods shared by the two integrated-acceleration results (sliding and PIMS)."""
 
-    Attributes
-    ----------
-    window_s : window length, s (the record length if the record is shorter)
-    t_start : (nw,) window start times, s
-    delta_v : (naxes, nw) integral over each window, m/s
-    max_mps : (naxes,) max |delta_v| per axis, m/s
-    max_magnitude_mps : max over windows of the vector norm of delta_v, m/s
-    """
-
+    DEFINITION: str
     window_s: float
     t_start: np.ndarray
     delta_v: np.ndarray
     max_mps: np.ndarray
     max_magnitude_mps: float
 
-    #: what the integral is (in :meth:`to_dict` and :meth:`to_xarray`)
-    DEFINITION = (
-        "max over windows starting at every sample of |integral of the raw acceleration "
-        "over window_s| (microg, conservative)"
-    )
+    def _extra(self) -> dict[str, Any]:
+        """Keys a result adds to :meth:`to_dict` after ``window_s``."""
+        return {}
 
     def to_dict(self, axes: tuple[str, ...] | None = None) -> dict[str, Any]:
         """JSON-ready summary: the window and the largest integrals, m/s.
@@ -394,6 +383,7 @@ class IntegratedAcceleration:
         return {
             "definition": self.DEFINITION,
             "window_s": self.window_s,
+            **self._extra(),
             "n_windows": int(self.t_start.size),
             "max_mps_axis": dict(zip(ax, _numbers(self.max_mps), strict=True)),
             "max_magnitude_mps": json_number(self.max_magnitude_mps),
@@ -426,11 +416,38 @@ class IntegratedAcceleration:
         """Each window's integral against its start (``plotting.environment.plot_integrated``)."""
         from microg.plotting.environment import plot_integrated
 
-        return plot_integrated(self, axes=axis_names(self.delta_v.shape[0], axes), title=title)
+        me: Any = self  # one of the two subclasses
+        return plot_integrated(me, axes=axis_names(self.delta_v.shape[0], axes), title=title)
 
 
 @dataclass(frozen=True)
-class IntegratedBlocks:
+class IntegratedAcceleration(_WindowIntegrals):
+    """Integral of the acceleration over sliding windows (velocity change), m/s.
+
+    Attributes
+    ----------
+    window_s : window length, s (the record length if the record is shorter)
+    t_start : (nw,) window start times, s
+    delta_v : (naxes, nw) integral over each window, m/s
+    max_mps : (naxes,) max |delta_v| per axis, m/s
+    max_magnitude_mps : max over windows of the vector norm of delta_v, m/s
+    """
+
+    window_s: float
+    t_start: np.ndarray
+    delta_v: np.ndarray
+    max_mps: np.ndarray
+    max_magnitude_mps: float
+
+    #: what the integral is (in :meth:`to_dict` and :meth:`to_xarray`)
+    DEFINITION = (
+        "max over windows starting at every sample of |integral of the raw acceleration "
+        "over window_s| (microg, conservative)"
+    )
+
+
+@dataclass(frozen=True)
+class IntegratedBlocks(_WindowIntegrals):
     """PIMS's integrated acceleration: consecutive demeaned blocks, m/s.
 
     Attributes
@@ -461,49 +478,9 @@ class IntegratedBlocks:
         "trapezoidal integral of each (NASA PIMS file_trapz)"
     )
 
-    def to_dict(self, axes: tuple[str, ...] | None = None) -> dict[str, Any]:
-        """JSON-ready summary: the window and the largest integrals, m/s.
-
-        No per-window rows; those are in :meth:`to_xarray`.
-        """
-        ax = axis_names(self.delta_v.shape[0], axes)
-        return {
-            "definition": self.DEFINITION,
-            "window_s": self.window_s,
-            "block_samples": self.block_samples,
-            "n_windows": int(self.t_start.size),
-            "max_mps_axis": dict(zip(ax, _numbers(self.max_mps), strict=True)),
-            "max_magnitude_mps": json_number(self.max_magnitude_mps),
-        }
-
-    def to_xarray(self, axes: tuple[str, ...] | None = None) -> Any:
-        """The integral of each window as an ``xarray.Dataset``.
-
-        ``delta_v_mps`` on dims ``axis``, ``t_start_s``.
-        """
-        ax = axis_names(self.delta_v.shape[0], axes)
-        return _dataset(
-            {
-                "delta_v_mps": (
-                    ("axis", "t_start_s"),
-                    self.delta_v,
-                    {"units": "m/s", "long_name": "integral of the acceleration"},
-                ),
-                "max_mps": ("axis", self.max_mps, {"units": "m/s"}),
-            },
-            {"axis": list(ax), "t_start_s": ("t_start_s", self.t_start, {"units": "s"})},
-            {
-                "definition": self.DEFINITION,
-                "window_s": self.window_s,
-                "max_magnitude_mps": self.max_magnitude_mps,
-            },
-        )
-
-    def plot(self, axes: tuple[str, ...] | None = None, *, title: str = "") -> Figure:
-        """Each window's integral against its start (``plotting.environment.plot_integrated``)."""
-        from microg.plotting.environment import plot_integrated
-
-        return plot_integrated(self, axes=axis_names(self.delta_v.shape[0], axes), title=title)
+    def _extra(self) -> dict[str, Any]:
+        """``block_samples`` (PIMS's block length in samples)."""
+        return {"block_samples": self.block_samples}
 
 
 @dataclass(frozen=True)
