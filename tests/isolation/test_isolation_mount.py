@@ -73,3 +73,35 @@ def test_undamped_resonance_exactly_on_a_bin_is_margin_zero_not_a_warning() -> N
     choice = search_mount(spec, iss_requirement(), mass, k_on_bin, zetas=(0.0,), decades=0.0, n_k=1)
     assert choice.k1 == k_on_bin
     assert choice.min_margin == 0.0 and not choice.found
+
+
+def test_screen_margins_equal_each_candidates_own_band_rms() -> None:
+    # reference: each candidate mount alone, as a Spectrum of psd |T|^2 with T the complex
+    # transmissibility (mount_transmissibility) through band_rms; the screen's real |T|^2 and
+    # one product per axis agree to rounding (1e-12 relative)
+    from microg.environment.metrics import Spectrum, band_rms
+    from microg.environment.requirements import iss_requirement
+    from microg.isolation.mount import screen_margins
+    from microg.units import G0
+
+    rng = np.random.default_rng(3)
+    df = 0.01
+    f = np.arange(0, 5001) * df
+    psd = rng.random((3, f.size)) * 1e-12
+    spec = Spectrum(f, psd, df, f[-1], "periodogram")
+    req = iss_requirement()
+    mass, k_max, zetas = 450.0, 450.0 * (2 * np.pi * 3.3) ** 2, (0.0, 0.1, 0.7)
+    got = screen_margins(spec, req, mass, k_max, zetas, 3.0, 7)
+    keep = req.bands.lower_hz < spec.nyquist_hz
+    for iz, z in enumerate(zetas):
+        for ik, k in enumerate(k_max * np.logspace(-3.0, 0.0, 7)):
+            c = 2 * z * np.sqrt(k * mass)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                t2 = np.abs(mount_transmissibility(k, c, mass, 2 * np.pi * f)) ** 2
+            if not np.all(np.isfinite(t2)):  # k_max's f_n = 3.3 Hz is a bin: unbounded
+                assert z == 0.0 and k == k_max and got[iz, ik] == 0.0
+                continue
+            rms_g = band_rms(Spectrum(f, psd * t2, df, f[-1], "x"), req.bands).rms / G0
+            with np.errstate(divide="ignore"):  # bands holding only the (excluded) mean
+                ref = np.min(np.where(rms_g > 0, req.limit_g[keep] / rms_g, np.inf))
+            assert got[iz, ik] == pytest.approx(ref, rel=1e-12)

@@ -66,6 +66,7 @@ __all__ = [
     "json_number",
     "acceleration_psd",
     "band_rms",
+    "band_weights",
     "integrated_acceleration",
     "integrated_acceleration_pims",
     "assess",
@@ -838,6 +839,55 @@ def acceleration_psd(
     )
 
 
+def band_weights(freq_hz: np.ndarray, df_hz: float, nyquist_hz: float, bands: BandTable) -> Any:
+    """The band integration as a linear map: ``power_b = sum_k W[b, k] psd_k``, Hz.
+
+    Bin ``k`` covers ``[f_k - df/2, f_k + df/2]`` clipped to ``[0, nyquist]`` and carries
+    ``psd_k df``; a band ``[lo, hi]`` (clipped to Nyquist) takes the fraction of each bin it
+    overlaps (the PSD constant across a bin), and the 0-Hz bin's power (the mean) is left out.
+    ``W[b, k] = df |[lo, hi] ∩ bin_k| / |bin_k|``.  Sparse: each band covers a run of bins.
+
+    Parameters
+    ----------
+    freq_hz : ndarray (nf,)
+        Bin frequencies, Hz, uniformly spaced from 0.
+    df_hz : float
+        Bin spacing, Hz.
+    nyquist_hz : float
+        Half the sampling rate, Hz.
+    bands : BandTable
+        The bands, Hz.
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix (nb, nf)
+        Hz.
+    """
+    import scipy.sparse as sp
+
+    f = np.asarray(freq_hz, float)
+    nb = bands.center_hz.size
+    edges = np.r_[0.0, np.minimum(f + df_hz / 2, nyquist_hz)]
+    lo = np.minimum(bands.lower_hz, nyquist_hz)
+    hi = np.minimum(bands.upper_hz, nyquist_hz)
+    # bins j0 <= j < j1 overlap [lo, hi]
+    j0 = np.clip(np.searchsorted(edges, lo, side="right") - 1, 0, f.size)
+    j1 = np.clip(np.searchsorted(edges, hi, side="left"), 0, f.size)
+    j1 = np.maximum(j1, j0)
+    count = j1 - j0
+    rows = np.repeat(np.arange(nb), count)
+    cols = np.repeat(j0 - np.cumsum(np.r_[0, count[:-1]]), count) + np.arange(int(count.sum()))
+    a, b = edges[cols], edges[cols + 1]
+    width = b - a
+    overlap = np.minimum(b, hi[rows]) - np.maximum(a, lo[rows])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        frac = np.where(width > 0, np.clip(overlap, 0.0, None) / width, 0.0)
+    w = frac * df_hz
+    if f.size and f[0] == 0.0:
+        w = np.where(cols == 0, 0.0, w)  # the mean is no vibration
+    return sp.csr_matrix((w, (rows, cols)), shape=(nb, f.size))
+
+
 def band_rms(
     spectrum: Spectrum,
     bands: BandTable,
@@ -862,16 +912,9 @@ def band_rms(
     nyq = spectrum.nyquist_hz
     keep = bands.lower_hz < nyq
     kept = BandTable(bands.center_hz[keep], bands.lower_hz[keep], bands.upper_hz[keep])
-    # bin k covers [f_k - df/2, f_k + df/2] clipped to [0, nyq]; the DC bin carries no power
-    power_bins = psd * df
-    if f.size and f[0] == 0.0:
-        power_bins = power_bins.copy()
-        power_bins[:, 0] = 0.0
-    edges = np.r_[0.0, np.minimum(f + df / 2, nyq)]
-    cum = np.concatenate([np.zeros((psd.shape[0], 1)), np.cumsum(power_bins, axis=1)], axis=1)
     lo = np.minimum(kept.lower_hz, nyq)
     hi = np.minimum(kept.upper_hz, nyq)
-    power = np.array([np.interp(hi, edges, c) - np.interp(lo, edges, c) for c in cum])
+    power = np.asarray(band_weights(f, df, nyq, kept) @ np.atleast_2d(psd).T).T
     width = kept.upper_hz - kept.lower_hz
     coverage = (hi - lo) / width
     n_bins = (hi - lo) / df

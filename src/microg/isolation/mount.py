@@ -17,14 +17,14 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from microg.environment.metrics import Spectrum, band_rms, json_number
-from microg.environment.requirements import Requirement
+from microg.environment.metrics import Spectrum, json_number
+from microg.environment.requirements import BandTable, Requirement
 from microg.units import G0, IN, LBF
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-__all__ = ["mount_transmissibility", "MountChoice", "search_mount"]
+__all__ = ["mount_transmissibility", "MountChoice", "screen_margins", "search_mount"]
 
 
 def mount_transmissibility(
@@ -126,6 +126,75 @@ class MountChoice:
         return plot_mount_choice(self)
 
 
+def screen_margins(
+    spectrum: Spectrum,
+    requirement: Requirement,
+    mass: float,
+    k_max: float,
+    zetas: tuple[float, ...],
+    decades: float,
+    n_k: int,
+) -> np.ndarray:
+    """Smallest band margin of the package on each screened mount, ``(len(zetas), n_k)``.
+
+    The package's PSD is ``|T(omega)|^2`` times the mount's, with
+    ``|T|^2 = (k^2 + (c omega)^2) / ((k - m omega^2)^2 + (c omega)^2)`` (the modulus of
+    :func:`mount_transmissibility`), and a band's power is linear in the PSD
+    (:func:`~microg.environment.metrics.band_weights`, the integration of
+    :func:`~microg.environment.metrics.band_rms`): all candidates of one damping ratio are one
+    sparse-dense product per axis.  The margin is ``min limit / band RMS`` over the bands
+    below Nyquist and the axes (``inf`` where no band has power); 0 for an undamped mount
+    resonant exactly on a bin carrying power (an unbounded response).
+
+    Parameters
+    ----------
+    spectrum : Spectrum
+        One-sided PSD of the mount acceleration, per axis ((m/s^2)^2/Hz).
+    requirement : Requirement
+        Band limits (g).
+    mass : float
+        Package mass, kg.
+    k_max : float
+        Stiffest mount, N/m; the stiffnesses are ``k_max * logspace(-decades, 0, n_k)``.
+    zetas : tuple of float
+        Mount damping ratios.
+    decades : float
+        Width of the log-spaced stiffness range.
+    n_k : int
+        Number of stiffness values.
+    """
+    from microg.environment.metrics import band_weights
+
+    omega = 2 * np.pi * spectrum.freq_hz
+    keep = requirement.bands.lower_hz < spectrum.nyquist_hz
+    limit = requirement.limit_g[keep]
+    kept = BandTable(
+        requirement.bands.center_hz[keep],
+        requirement.bands.lower_hz[keep],
+        requirement.bands.upper_hz[keep],
+    )
+    w = band_weights(spectrum.freq_hz, spectrum.df_hz, spectrum.nyquist_hz, kept)
+    psd = np.atleast_2d(spectrum.psd)
+    weighted = [w.multiply(p[None, :]).tocsr() for p in psd]  # (nb, nf) per axis
+    power_bins = np.any(psd > 0, axis=0)
+    k_grid = k_max * np.logspace(-decades, 0.0, n_k)
+    w2 = omega**2
+    out = np.empty((len(zetas), n_k))
+    for iz, zeta1 in enumerate(zetas):
+        c1 = 2 * zeta1 * np.sqrt(k_grid * mass)
+        cw2 = (c1[:, None] ** 2) * w2[None, :]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t2 = (k_grid[:, None] ** 2 + cw2) / ((k_grid[:, None] - mass * w2[None, :]) ** 2 + cw2)
+        unbounded = ~np.all(np.isfinite(t2[:, power_bins]), axis=1)
+        t2 = np.where(np.isfinite(t2), t2, 0.0)  # bins without power
+        rms_g = np.stack([np.sqrt(np.maximum(wa @ t2.T, 0.0)).T for wa in weighted]) / G0
+        with np.errstate(divide="ignore"):
+            ratio = np.where(rms_g > 0, limit / np.maximum(rms_g, 1e-300), np.inf)
+        m = np.min(ratio, axis=(0, 2)) if ratio.size else np.full(n_k, np.inf)
+        out[iz] = np.where(unbounded, 0.0, m)
+    return out
+
+
 def search_mount(
     spectrum: Spectrum,
     requirement: Requirement,
@@ -156,33 +225,13 @@ def search_mount(
     n_k : int
         Number of stiffness values.
     """
-    omega = 2 * np.pi * spectrum.freq_hz
-    keep = requirement.bands.lower_hz < spectrum.nyquist_hz
-    limit = requirement.limit_g[keep]
-    best = None
+    margins = screen_margins(spectrum, requirement, mass, k_max, zetas, decades, n_k)
     k_grid = k_max * np.logspace(-decades, 0.0, n_k)
-    for zeta1 in zetas:
-        for k1 in k_grid:
+    best = None
+    for iz, zeta1 in enumerate(zetas):  # the first of equal candidates wins, as screened
+        for ik, k1 in enumerate(k_grid):
             c1 = 2 * zeta1 * np.sqrt(k1 * mass)
-            with np.errstate(divide="ignore", invalid="ignore"):
-                t2 = np.abs(mount_transmissibility(k1, c1, mass, omega)) ** 2
-            power = np.any(np.atleast_2d(spectrum.psd) > 0, axis=0)
-            if not np.all(np.isfinite(t2[power])):
-                # an undamped mount's resonance exactly on a bin carrying power: an
-                # unbounded response, margin 0 (never a candidate)
-                cand = (False, 0.0, k1, zeta1, c1, 0.0)
-                if best is None or cand[:2] > best[:2]:
-                    best = cand
-                continue
-            t2 = np.where(np.isfinite(t2), t2, 0.0)  # bins without power
-            spec = Spectrum(
-                spectrum.freq_hz, spectrum.psd * t2, spectrum.df_hz, spectrum.nyquist_hz, "screen"
-            )
-            rms_g = band_rms(spec, requirement.bands).rms / G0
-            with np.errstate(divide="ignore"):
-                margin = float(
-                    np.min(np.where(rms_g > 0, limit / np.maximum(rms_g, 1e-300), np.inf))
-                )
+            margin = float(margins[iz, ik])
             cand = (margin >= 1.0, k1 if margin >= 1.0 else margin, k1, zeta1, c1, margin)
             if best is None or cand[:2] > best[:2]:
                 best = cand
