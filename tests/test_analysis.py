@@ -435,3 +435,26 @@ def test_results_as_xarray_carry_units_and_the_same_numbers():
         assert c.freq_hz.attrs["units"] == "Hz"
     np.testing.assert_array_equal(ds.time.values, r.timepts)
     assert ds.accel_mps2.attrs["units"] == "m/s^2" and ds.time.attrs["units"] == "s"
+
+
+def test_no_mode_in_the_response_is_refused_not_a_green_verdict():
+    # the clamped NASTRAN beam (tests/data/nastran, SOL 103, SPC'd: no rigid-body mode) has
+    # its first mode at 456.66 Hz (the F06): below the default 10-Hz max_freq no mode enters,
+    # the response would be identically zero, and "complies" would rest on nothing
+    import microg
+
+    path = Path(__file__).parent / "data" / "nastran" / "beam_modes_m2.op2"
+    model = microg.load_model(path, units="in,lbf,s")
+    with pytest.raises(microg.InputError, match="no mode enters the response") as err:
+        microg.analyze(model, force="crew-pushoff", at="grid:11", observe=["grid:6"])
+    assert err.value.where == "max_freq" and "456.7 Hz" in err.value.fix
+
+
+def test_rigid_only_response_is_said():
+    # max_freq below the IOC's first elastic mode (0.17 Hz, the modes table): the response
+    # is the rigid-body motion alone, which the result says
+    import microg
+
+    r = microg.analyze("ioc", observe=["lab"], max_freq="0.05 Hz", duration="100 s")
+    assert any("no elastic mode below max_freq" in w for w in r.warnings)
+    assert not any(r.used & r.modes.elastic)

@@ -1133,6 +1133,7 @@ def run_analysis(
     observations: dict[str, Observation] = {}
     t = np.zeros(0)
     if opts.disturbances:
+        warnings += _check_modes_used(modes, np.asarray(elastic, bool), used, opts.max_freq_hz)
         observations, t, w = _transient(structure, modes, used, opts, req, step)
         warnings += w
     vib = None
@@ -1161,6 +1162,33 @@ def run_analysis(
         meta=_meta(model, command),
         frequency_domain=vib,
     )
+
+
+def _check_modes_used(
+    modes: Modes, elastic: np.ndarray, used: np.ndarray, max_freq_hz: float
+) -> list[str]:
+    """Refuse a transient response without any mode; warn when it holds no elastic mode.
+
+    Without rigid modes (a clamped or imported model whose modes all lie above
+    ``max_freq_hz``) the response would be identically zero and the verdict a green
+    "complies" that no number supports.
+    """
+    el_freq = modes.freq_hz[elastic]
+    lowest = float(el_freq.min()) if el_freq.size else float("nan")
+    if not np.any(used):
+        raise InputError(
+            f"no mode enters the response: the model has no rigid-body mode and its lowest "
+            f"mode ({lowest:.4g} Hz) is above max_freq = {max_freq_hz:g} Hz, so the response "
+            "would be zero",
+            where="max_freq",
+            fix=f"raise max_freq above {lowest:.4g} Hz (and dt to resolve it)",
+        )
+    if el_freq.size and not np.any(used & elastic):
+        return [
+            f"no elastic mode below max_freq = {max_freq_hz:g} Hz (the lowest is "
+            f"{lowest:.4g} Hz): the response is the rigid-body motion alone"
+        ]
+    return []
 
 
 def _transient(
