@@ -181,3 +181,20 @@ def test_uff_export_round_trip_through_the_cli(capsys, tmp_path):
     assert rc == 0, err
     back = np.array([m["omega"] for m in json.loads(out)["modes"]])
     np.testing.assert_allclose(back, fe, rtol=1e-5, atol=0)
+
+
+def test_uff_export_of_an_imported_modal_model(capsys, tmp_path):
+    # a NASTRAN OP2 (clamped beam: no rigid mode) written as UFF and read back: the same
+    # frequencies to the 6 printed digits (1e-5), and replaced_rigid says none was replaced
+    unv = tmp_path / "beam.unv"
+    op2 = str(NASTRAN / "beam_modes_m2.op2")
+    rc, out, err = _run(capsys, op2, "--units", "in,lbf,s", "--uff", str(unv), "--json")
+    assert rc == 0 and unv.is_file(), err
+    first = json.loads(out)
+    assert first["replaced_rigid"]["count"] == 0
+    rc, out, err = _run(capsys, str(unv), "--json")
+    assert rc == 0, err
+    a = np.array([m["freq_hz"] for m in first["modes"]])
+    b = np.array([m["freq_hz"] for m in json.loads(out)["modes"]])
+    np.testing.assert_allclose(b, a, rtol=1e-5, atol=0)
+    assert a[0] == pytest.approx(456.66, rel=1e-4)  # the F06's first frequency

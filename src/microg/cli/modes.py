@@ -166,10 +166,13 @@ def modes(
         if uff_out is not None:
             from microg.models.uff import write_uff_modes
 
-            write_uff_modes(m, uff_out)
+            from microg.models.modal import ModalModel
+
+            # an imported modal model is written from its own grids and shapes
+            write_uff_modes(mdl if isinstance(mdl, ModalModel) else m, uff_out)
     plane_out = structure.plane if structure.plane else (plane if fem_plane else None)
     name = getattr(mdl, "name", None) or structure.meta.get("model", model)
-    replaced = structure.meta.get("replaced_rigid", {"count": 0, "max_file_freq_hz": None})
+    replaced = structure.meta.get("replaced_rigid") or {"count": 0, "max_file_freq_hz": None}
     if as_json:
         data = m.to_dict()
         out = {"model": name, "plane": plane_out, **data, "replaced_rigid": replaced}
