@@ -164,9 +164,8 @@ def modes(
         else:
             m = microg.solve_modes(structure, n_modes=want)
         if uff_out is not None:
-            from microg.models.uff import write_uff_modes
-
             from microg.models.modal import ModalModel
+            from microg.models.uff import write_uff_modes
 
             # an imported modal model is written from its own grids and shapes
             write_uff_modes(mdl if isinstance(mdl, ModalModel) else m, uff_out)
