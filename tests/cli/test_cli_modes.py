@@ -198,3 +198,27 @@ def test_uff_export_of_an_imported_modal_model(capsys, tmp_path):
     b = np.array([m["freq_hz"] for m in json.loads(out)["modes"]])
     np.testing.assert_allclose(b, a, rtol=1e-5, atol=0)
     assert a[0] == pytest.approx(456.66, rel=1e-4)  # the F06's first frequency
+
+
+DECK = Path(__file__).resolve().parents[3] / "shared" / "fixtures" / "nastran" / "beam_modes"
+
+
+def test_a_decks_spc_is_said_and_applied_on_request(capsys):
+    # the shared NASTRAN fixture is clamped by SPC = 1: free-free by default, with a warning
+    # that the SPC is not applied; --constrained applies it and gives NASTRAN's first
+    # frequency (F06: 456.6603 Hz; tests/models/test_bdf.py holds every mode to 0.5 %)
+    if not (DECK / "beam_modes.dat").is_file():
+        pytest.skip("shared fixture not present")
+    deck = str(DECK / "beam_modes.dat")
+    rc, out, err = _run(capsys, deck, "--units", "in,lbf,s", "--json")
+    assert rc == 0, err
+    free = json.loads(out)
+    assert any("SPC" in w and "not applied" in w for w in free["warnings"])
+    assert sum(m["rigid"] for m in free["modes"]) == 6
+    rc, out, err = _run(capsys, deck, "--units", "in,lbf,s", "--constrained", "--json")
+    assert rc == 0, err
+    clamped = json.loads(out)
+    assert not any("not applied" in w for w in clamped.get("warnings", []))
+    assert clamped["modes"][0]["freq_hz"] == pytest.approx(456.6603, rel=5e-3)
+    rc, _, err = _run(capsys, "ioc", "--constrained")
+    assert rc == 2 and "--constrained" in err and "\n" not in err.strip()

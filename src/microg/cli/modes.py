@@ -22,6 +22,7 @@ FLAGS = {
     "units": "--units",
     "wtmass": "--wtmass",
     "points": "--points",
+    "constrained": "--constrained",
 }
 
 
@@ -107,6 +108,11 @@ def _effective_percent(m: Any) -> dict[str, Any]:
     default=None,
     help="Also write the modes as UFF datasets 15+55 (+164 units) to this file.",
 )
+@click.option(
+    "--constrained",
+    is_flag=True,
+    help="A NASTRAN deck or frame model: apply its SPCs (the clamped run); default free-free.",
+)
 @click.option("--json", "as_json", is_flag=True, help="Print the modes as JSON.")
 def modes(
     model: str,
@@ -120,6 +126,7 @@ def modes(
     wtmass: float | None,
     points: Path | None,
     uff_out: Path | None,
+    constrained: bool,
     as_json: bool,
 ) -> None:
     """Natural frequencies and mode properties of MODEL (a model file or a shipped name).
@@ -151,6 +158,7 @@ def modes(
             plane="3d" if fem_plane else plane,
             n=elements if method == "fem" else functions,
             gravity_gradient=gravity_gradient,
+            constrained=constrained,
         )
         want = n_modes
         if structure.is_sparse and want is None:
@@ -195,14 +203,18 @@ def modes(
     unstable = np.asarray(m.unstable, bool)
     for j in range(m.n_modes):
         kind = "yes" if m.rigid[j] else ("UNST" if unstable[j] else "no")
-        row = (
-            f"{j + 1:>3} {m.omega[j]:>14.6g} {m.freq_hz[j]:>11.5g} "
-            f"{kind:>5} {m.modal_mass[j]:>16.6g}"
-        )
+        if unstable[j]:  # an imaginary frequency: omega = i * growth rate
+            rate = float(np.asarray(m.growth_rate, float)[j])
+            om, fr = f"{rate:.6g}i", f"{rate / (2 * np.pi):.5g}i"
+        else:
+            om, fr = f"{m.omega[j]:.6g}", f"{m.freq_hz[j]:.5g}"
+        row = f"{j + 1:>3} {om:>14} {fr:>11} {kind:>5} {m.modal_mass[j]:>16.6g}"
         row += "".join(f" {_pct(pct[d][j]):>9}" for d in dirs)
         click.echo(row)
     for note in m.notes:
         click.echo(f"  note: {note}")
+    for warning in structure.meta.get("warnings", ()):
+        click.echo(f"  warning: {warning}")
 
 
 def _pct(v: float) -> str:

@@ -41,6 +41,7 @@ def discretize(
     plane: str = "3d",
     n: int | None = None,
     gravity_gradient: bool = False,
+    constrained: bool = False,
 ) -> Structure:
     """Discretise a station model (or pass a modal model's structure through).
 
@@ -60,6 +61,9 @@ def discretize(
         (``ritz``, default :data:`DEFAULT_FUNCTIONS`).
     gravity_gradient : bool
         Add the gravity-gradient (libration) stiffness on the rigid rotations.
+    constrained : bool
+        A frame (graph) model only: apply its single-point constraints (a NASTRAN deck's SPC
+        set), as the clamped run does; default free-free.
 
     Returns
     -------
@@ -73,7 +77,13 @@ def discretize(
     if kind == "GraphModel":
         from microg.structure.frame import build_frame
 
-        return build_frame(model)
+        return build_frame(model, constrained=constrained)
+    if constrained:
+        raise InputError(
+            "applies to frame (graph) models only, such as a NASTRAN deck",
+            where="constrained",
+            fix="omit it: station models are free-free",
+        )
     if isinstance(model, Structure):
         return model
     if method not in METHODS:

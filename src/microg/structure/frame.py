@@ -1252,6 +1252,14 @@ def build_frame(
     n_ind = T.shape[1]
     keep = np.ones(n_ind, bool)
     applied: list[str] = []
+    if graph.constraints and not constrained:
+        nodes = sorted({c.node for c in graph.constraints})
+        shown = ", ".join(nodes[:5]) + (", ..." if len(nodes) > 5 else "")
+        warnings.append(
+            f"the model's single-point constraints (SPC) at {len(nodes)} node(s) ({shown}) are "
+            "not applied: this is the free-free structure (constrained=True, or --constrained, "
+            "applies them, as a clamped NASTRAN run does)"
+        )
     if constrained:
         index = graph.node_index()
         pos_ind = np.full(T.shape[0], -1)
