@@ -458,3 +458,23 @@ def test_rigid_only_response_is_said():
     r = microg.analyze("ioc", observe=["lab"], max_freq="0.05 Hz", duration="100 s")
     assert any("no elastic mode below max_freq" in w for w in r.warnings)
     assert not any(r.used & r.modes.elastic)
+
+
+def test_to_dict_is_strict_json_and_carries_the_force_parameters():
+    # the review board's provenance: the push-off's parameters as given (40 lbf = 177.929 N
+    # by the definition of the lbf; t1 as written), and to_dict() is plain JSON (no numpy
+    # arrays, no NaN/Infinity tokens), equal to the CLI's writer's output
+    import json
+
+    import microg
+    from microg._io import dumps
+
+    r = microg.analyze(
+        "ioc", force="crew-pushoff:f0=40lbf,t1=0.5s", observe=["lab"], duration="100 s"
+    )
+    d = r.to_dict()
+    assert json.loads(json.dumps(d, allow_nan=False)) == json.loads(dumps(d))
+    p = d["disturbances"][0]["params"]
+    assert p["f0_N"] == pytest.approx(40 * 4.4482216152605, rel=1e-12)
+    assert p["t1_s"] == 0.5 and p["t13_s"] == 13.0 and p["t14_s"] == 14.0
+    assert d["disturbances"][0]["direction"] == [1.0, 0.0, 0.0]

@@ -484,7 +484,7 @@ def _disturbance_dict(d: Disturbance) -> dict[str, Any]:
     out: dict[str, Any] = {
         "name": f.name,
         "at": d.point,
-        "direction": None if f.is_vector else direction,
+        "direction": None if f.is_vector else [float(v) for v in direction],
         "direction_axis": "varies (three components)" if f.is_vector else axis_name(direction),
         "peak_force_N": float(np.max(np.linalg.norm(vec, axis=0))),
         "impulse_Ns": float(np.linalg.norm(impulse)),
@@ -492,9 +492,8 @@ def _disturbance_dict(d: Disturbance) -> dict[str, Any]:
         "end_s": float(f.timepts[-1]),
         "final_force_N": float(np.linalg.norm(vec[:, -1])),
     }
-    params = getattr(f, "params", None)
-    if params:
-        out["params"] = dict(params)
+    if f.params:
+        out["params"] = {k: float(v) for k, v in f.params.items()}
     return out
 
 

@@ -102,6 +102,8 @@ class ForceHistory:
         direction, which wins over the direction it is applied in)
     vector : optional (3, nb) force vector at each breakpoint, N, model frame (a direction
         that varies in time); give ``force=None`` with it
+    params : optional parameters that generated it, named with their units (``f0_N``,
+        ``t1_s``, ...; the provenance in reports), or None
 
     Limits: times within +/- ``LIMITS["time"]`` (1e7 s), each force component within
     +/- ``LIMITS["force"]`` (1e7 N), all finite.
@@ -112,6 +114,7 @@ class ForceHistory:
     name: str = "force"
     direction: np.ndarray | None = field(default=None)
     vector: np.ndarray | None = field(default=None)
+    params: dict[str, float] | None = field(default=None, compare=False)
 
     def __post_init__(self) -> None:
         where = f"force {self.name!r}"
@@ -685,8 +688,12 @@ class Activity:
 
     def history(self, name: str | None = None, **overrides: float) -> ForceHistory:
         """The force history, with any of f0 (N), t1, t13, t14 (s) overridden."""
-        t, f = self.pushoff(**overrides).breakpoints()
-        return ForceHistory(t, f, name or self.name)
+        p = self.pushoff(**overrides)
+        t, f = p.breakpoints()
+        params = {"f0_N": p.f0, "t1_s": p.t1, "t13_s": p.t13, "t14_s": p.t14}
+        return ForceHistory(
+            t, f, name or self.name, params={k: float(v) for k, v in params.items()}
+        )
 
 
 @lru_cache(maxsize=1)
