@@ -55,16 +55,19 @@ def test_modal_mass_from_sample_peaks_equals_the_dense_displacements():
     st = modal_structure(model, ["grid:7"])
     modes = solve_modes(st)
     # reference: 1/p^2 with p the largest of the points' translations and rotations (times
-    # L_c) and every grid's translation, all formed densely (einsum over all grids)
+    # L_c) and every grid's translation and rotation (times L_c: the Modes docstring), all
+    # formed densely (einsum over all grids)
     lc = characteristic_length(st)
     p = st.point("grid:7")
     dense = np.einsum("gam,mk->gak", model.phi[:, :3, :], modes.phi)
+    dense_rot = np.einsum("gam,mk->gak", model.phi[:, 3:6, :], modes.phi)
     peak = np.max(
         np.stack(
             [
                 np.max(np.abs(p.translation @ modes.phi), axis=0),
                 lc * np.max(np.abs(p.rotation @ modes.phi), axis=0),
                 np.max(np.abs(dense), axis=(0, 1)),
+                lc * np.max(np.abs(dense_rot), axis=(0, 1)),
             ]
         ),
         axis=0,
@@ -128,3 +131,29 @@ def test_contributions_equal_each_modes_own_series():
         np.testing.assert_allclose(c.worst_band_rms_g, ref, rtol=1e-12, atol=1e-15 * ref.max())
         checked_band += 1
     assert checked_band >= 1  # the band path was exercised
+
+
+def test_modal_mass_of_an_imported_torsion_mode_counts_rotations():
+    # the NASTRAN beam's 5th mode (2674.6 Hz... the first torsion, tests/data/nastran) barely
+    # translates a grid: its modal mass is 1/p^2 with p = max(|u|, L_c |theta|) over the
+    # grids (Modes docstring), computed here from the file's own shapes; before rotations
+    # were counted it was 4e27 kg
+    from pathlib import Path
+
+    import microg
+    from microg.dynamics.modes import characteristic_length, solve_modes
+    from microg.structure.discretize import discretize
+
+    path = Path(__file__).resolve().parents[1] / "data" / "nastran" / "beam_modes_m2.op2"
+    model = microg.load_model(path, units="in,lbf,s")
+    s = discretize(model)
+    m = solve_modes(s)
+    lc = characteristic_length(s)
+    shapes = model.phi  # (grids, 6, modes), mass-normalised, SI
+    p = np.maximum(
+        np.abs(shapes[:, :3]).max(axis=(0, 1)), lc * np.abs(shapes[:, 3:6]).max(axis=(0, 1))
+    )
+    np.testing.assert_allclose(m.modal_mass, 1.0 / p**2, rtol=1e-12)
+    t = np.abs(shapes[:, :3]).max(axis=(0, 1))
+    k = int(np.argmin(t / p))  # the mode that translates least: torsion
+    assert t[k] < 1e-6 * p[k] and m.modal_mass[k] < 10.0 * np.median(m.modal_mass)

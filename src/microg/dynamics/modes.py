@@ -72,7 +72,9 @@ class Modes:
         gyration about its centre of mass).  A mass-normalised shape with a largest motion
         ``p`` has modal mass ``1/p^2``.  Counting rotations means that no division by a
         vanishing translation can occur: a torsion mode that barely translates any point
-        has a modal mass bounded by the mass it moves, not 1e26 kg.
+        has a modal mass bounded by the mass it moves, not 1e26 kg.  (An imported mode that
+        moves only coordinates without a position, such as NASTRAN scalar points, which the
+        reader drops with a warning, has no such bound: its modal mass is not meaningful.)
     effective_mass : mapping of str to ndarray (m,)
         Modal effective mass ``(phi_j^T M r_d)^2`` per rigid-body direction ``r_d`` (kg for
         x, y, z; kg m^2 for rx, ry, rz about the centre of mass).  Exactly 0 where the
@@ -302,6 +304,7 @@ def _modal_mass_unit_peak(structure: Structure, phi: np.ndarray) -> np.ndarray:
         # modal-model samples (microg.structure.modal.ModalSamples): the largest translation
         # of each column without forming the (grids, 3, modes) displacements
         peaks.append(np.asarray(samples.peak_translation(phi), float))
+        peaks.append(lc * np.asarray(samples.peak_rotation(phi), float))
     elif samples is not None and hasattr(samples, "displacement"):
         # sparse-friendly samples (microg.structure.fem.NodeSamples): translations + rotations
         peaks.append(np.max(np.abs(samples.displacement(phi)), axis=(0, 1)))

@@ -127,7 +127,7 @@ class ModalSamples:
     def __init__(self, model: ModalModel):
         self._model = model
         self._labels: tuple[str, ...] | None = None
-        self._peak: np.ndarray | None = None
+        self._peaks: dict[str, np.ndarray] = {}
 
     @property
     def position(self) -> np.ndarray:
@@ -184,16 +184,20 @@ class ModalSamples:
             out[:, :, multi] = pt[:, :, rows] @ q[np.ix_(rows, multi)]
         return out
 
-    def shape_peaks(self) -> np.ndarray:
-        """Largest |translation| of each of the model's shapes over grids and axes (m,)."""
-        if self._peak is None:
-            # in blocks of grids: no (g, 3, m) temporary of |phi_t| (max commutes with blocks)
-            pt = self.phi_t
+    def shape_peaks(self, part: str = "translation") -> np.ndarray:
+        """Largest |translation| (or |rotation|, rad) of each shape over grids and axes (m,)."""
+        if part not in self._peaks:
+            # in blocks of grids: no (g, 3, m) temporary of |phi| (max commutes with blocks)
+            pt = self._part(part)
             peak = np.zeros(pt.shape[2])
             for i in range(0, pt.shape[0], _PEAK_BLOCK):
                 np.maximum(peak, np.max(np.abs(pt[i : i + _PEAK_BLOCK]), axis=(0, 1)), out=peak)
-            self._peak = peak
-        return self._peak
+            self._peaks[part] = peak
+        return self._peaks[part]
+
+    def _part(self, part: str) -> np.ndarray:
+        """The translational (g, 3, m) or rotational rows of the shapes, a view."""
+        return self._model.phi[:, :3, :] if part == "translation" else self._model.phi[:, 3:6, :]
 
     def peak_translation(self, q: np.ndarray) -> np.ndarray:
         """``max over grids and axes of |displacement(q)|`` per column of q (k,).
@@ -202,17 +206,31 @@ class ModalSamples:
         shape's own peak (rounding is monotone, so the maximum commutes with the scaling);
         other columns are formed over their nonzero rows.
         """
+        return self._peak_of(q, "translation")
+
+    def peak_rotation(self, q: np.ndarray) -> np.ndarray:
+        """``max over grids and axes of |rotation(q)|`` per column of q, rad (k,).
+
+        As :meth:`peak_translation`; zeros when the model's shapes carry no rotations.
+        """
+        return self._peak_of(q, "rotation")
+
+    def _peak_of(self, q: np.ndarray, part: str) -> np.ndarray:
         q = np.asarray(q, float).reshape(self._model.n_modes, -1)
+        if part == "rotation" and self._model.phi.shape[1] < 6:
+            return np.zeros(q.shape[1])
         nz = q != 0
         count = nz.sum(axis=0)
         out = np.zeros(q.shape[1])
         single = np.flatnonzero(count == 1)
         if single.size:
             r = np.argmax(nz[:, single], axis=0)
-            out[single] = np.abs(q[r, single]) * self.shape_peaks()[r]
+            out[single] = np.abs(q[r, single]) * self.shape_peaks(part)[r]
         multi = np.flatnonzero(count > 1)
         if multi.size:
-            out[multi] = np.max(np.abs(self.displacement(q[:, multi])), axis=(0, 1))
+            rows = np.flatnonzero(nz[:, multi].any(axis=1))
+            motion = self._part(part)[:, :, rows] @ q[np.ix_(rows, multi)]
+            out[multi] = np.max(np.abs(motion), axis=(0, 1))
         return out
 
 
