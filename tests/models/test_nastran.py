@@ -160,3 +160,37 @@ def test_op4_model_from_maa_kaa(tmp_path):
     assert np.allclose(mm.omega[6 : 6 + ne], ref.omega[el], rtol=1e-7)
     st = modal_structure(mm, samples=False)
     assert st.total_mass == pytest.approx(s.total_mass, rel=1e-10)
+
+
+def test_op2_without_geometry_takes_it_from_the_deck_beside_it(tmp_path):
+    # rdop2gpwg_1.op2 carries no GEOM1/BGPDT: its grids come from rdop2gpwg_1.dat beside it
+    # (microg's own deck reader, GRID/CORD2* only).  References: the deck's GRID cards read
+    # as plain fixed fields (all CP = 0, basic; in inches), and a deck of the same grids in
+    # a rotated and shifted CORD2R giving the same basic positions (exact for 0/90-degree
+    # axes up to rounding, 1e-12)
+    import microg
+    from microg.models.bdf import grid_geometry
+
+    dat = Path(__file__).resolve().parents[1] / "data" / "nastran" / "rdop2gpwg_1.dat"
+    rows = [ln for ln in dat.read_text().splitlines() if ln.startswith("GRID")]
+    ids = np.array([int(r[8:16]) for r in rows])
+    ref = np.array([[float(r[24 + 8 * k : 32 + 8 * k]) for k in range(3)] for r in rows])
+    xyz, cd, systems = grid_geometry(dat, ids)
+    np.testing.assert_array_equal(xyz, ref)
+    assert not cd.any() and systems == {}
+    # the same grids in CS 5 (origin (10, 0, 0), x along basic y, z along basic z)
+    lines = ["BEGIN BULK", "CORD2R  5       0       10.     0.      0.      10.     0.      1.",
+             "+       10.     1.      0."]  # fmt: skip
+    for g, p in zip(ids, ref, strict=True):
+        # basic p = origin + x_cs * e_y + y_cs * (-e_x) + z_cs * e_z
+        x_cs, y_cs, z_cs = p[1], 10.0 - p[0], p[2]
+        lines.append(f"GRID    {g:<8d}5       {x_cs:<8.4g}{y_cs:<8.4g}{z_cs:<8.4g}")
+    lines.append("ENDDATA")
+    deck = tmp_path / "cs5.dat"
+    deck.write_text("\n".join(lines) + "\n")
+    xyz5, _, systems5 = grid_geometry(deck, ids)
+    np.testing.assert_allclose(xyz5, ref, atol=1e-12 * np.abs(ref).max())
+    assert set(systems5) == {5}
+    # the OP2 reads through it: the rigid-body replacement fits the file's modes there
+    model = microg.load_model(dat.with_suffix(".op2"), units="in,lbf,s")
+    np.testing.assert_allclose(model.xyz_m, ref * 0.0254, rtol=1e-15, atol=0)

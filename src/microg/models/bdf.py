@@ -77,6 +77,7 @@ __all__ = [
     "SECTION_SHEAR_FACTORS",
     "SUPPORTED_CARDS",
     "Card",
+    "grid_geometry",
     "load_bdf",
     "read_cards",
 ]
@@ -1310,6 +1311,55 @@ class _Deck:
         for sid in members:
             out += [Constraint(n, comp) for n, comp in sets.get(sid, [])]
         return out
+
+
+def grid_geometry(
+    path: str | Path, ids: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, dict[int, Any]]:
+    """Positions of grids in the basic system, their output systems, and the deck's systems.
+
+    For an OP2 without geometry tables: only GRID and CORD2R/C/S cards (and INCLUDEs) are
+    read, in the deck's own length unit (the OP2 reader scales them with the rest).
+
+    Parameters
+    ----------
+    path : str or Path
+        The BDF deck beside the OP2.
+    ids : ndarray of int
+        The grids wanted (the OP2's), in order.
+
+    Returns
+    -------
+    xyz : ndarray (g, 3)
+        Basic coordinates, in the deck's length unit.
+    cd : ndarray (g,) of int
+        Each grid's output (displacement) coordinate system.
+    systems : dict of int to microg.models.nastran.CoordSystem
+        Every CORD2R/C/S, basic origin (deck length unit) and axes (columns).
+    """
+    from microg.models.nastran import CoordSystem
+
+    cards, case = read_cards(path)
+    keep = [c for c in cards if c.name in ("GRID", "CORD2R", "CORD2C", "CORD2S")]
+    deck = _Deck(keep, case, str(path), _Scales(1.0, 1.0, 1.0), None, None)
+    frames = deck.frames()
+    _, pos, _ = deck.grids(frames)
+    missing = [int(g) for g in ids if int(g) not in pos]
+    if missing:
+        raise InputError(
+            f"{len(missing)} grid(s) of the OP2 are not in the deck (first: {missing[0]})",
+            where=str(path),
+            fix="give the deck the OP2 was run from",
+        )
+    cd = {gid: c.integer(6, "CD", 0) for gid, c in deck.by_id(("GRID",), "grid").items()}
+    kinds = {"rectangular": "R", "cylindrical": "C", "spherical": "S"}
+    systems = {
+        int(cid): CoordSystem(int(cid), kinds[f.kind], np.asarray(f.origin, float), f.rotation.T)
+        for cid, f in frames.items()
+        if cid != 0
+    }
+    xyz = np.array([pos[int(g)] for g in ids], float).reshape(-1, 3)
+    return xyz, np.array([cd[int(g)] for g in ids], int), systems
 
 
 def load_bdf(
