@@ -478,3 +478,11 @@ def test_to_dict_is_strict_json_and_carries_the_force_parameters():
     assert p["f0_N"] == pytest.approx(40 * 4.4482216152605, rel=1e-12)
     assert p["t1_s"] == 0.5 and p["t13_s"] == 13.0 and p["t14_s"] == 14.0
     assert d["disturbances"][0]["direction"] == [1.0, 0.0, 0.0]
+
+
+def test_a_negative_duration_is_blamed_on_the_duration():
+    import microg
+
+    with pytest.raises(microg.InputError) as err:
+        microg.analyze("ioc", duration="-200 s")
+    assert err.value.where == "duration" and "must be > 0" in str(err.value)

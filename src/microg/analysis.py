@@ -790,6 +790,12 @@ def analyze(
 
 
 def _check_record(opts: AnalysisOptions) -> None:
+    if not opts.duration_s > 0:
+        raise InputError(
+            f"must be > 0, got {opts.duration_s:g} s",
+            where="duration",
+            fix="give the record's length, e.g. 200 s",
+        )
     if not (opts.dt_s > 0 and opts.duration_s > opts.dt_s):
         raise InputError(
             f"need 0 < dt < duration, got dt = {opts.dt_s:g} s, duration = {opts.duration_s:g} s",

@@ -24,6 +24,7 @@ FLAGS = {
     "scheduler": "--scheduler",
     "timeout": "--timeout",
     "heatmap": "--heatmap",
+    "restart": "--restart",
 }
 
 

@@ -39,7 +39,7 @@ def _units(
             raise InputError(
                 "NASTRAN files declare no units and none was given",
                 where=path,
-                fix='state them, e.g. units = "in, lbf, s" (points file) or --units "in,lbf,s"',
+                fix='state them, e.g. units="in, lbf, s" (or in the points file)',
             )
         return None
     return parse_units(text, where="units", wtmass=wt)

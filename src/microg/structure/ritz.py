@@ -183,7 +183,7 @@ def _check_functions(n_functions: int) -> None:
         raise InputError(
             f"assumed functions per beam must be an integer from 1 to {MAX_FUNCTIONS}, "
             f"got {n_functions!r}",
-            where="--functions/--elements",
+            where="n",
             fix="use the finite-element method for finer models",
         )
 

@@ -383,7 +383,7 @@ def _client(workers: int | None, scheduler: str | None, timeout_s: float) -> Ite
                 raise InputError(
                     f"the Dask scheduler at {scheduler!r} has no worker after {timeout_s:g} s",
                     where="scheduler",
-                    fix="start workers for it (dask worker ADDRESS), or use --workers N",
+                    fix="start workers for it (dask worker ADDRESS), or local ones (workers=N)",
                 ) from None
             yield client
         finally:

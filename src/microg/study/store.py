@@ -204,7 +204,7 @@ class SweepStore:
                 f"{self.path} holds the results of another study (or of another microg "
                 "version), so this sweep cannot resume it",
                 where=self.where,
-                fix="give another output directory, or --restart to discard those results",
+                fix="give another output directory, or restart=True to discard those results",
             )
 
     # ------------------------------------------------------------------ state
