@@ -13,11 +13,14 @@ References (independent of the sweep's linear algebra):
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
 from microg.dynamics.response import peak_response
 from microg.environment.metrics import assess
+from microg.errors import InputError
 from microg.isolation.timedomain import package_response
 from microg.study import CASE_DIMS, loads_study, sweep
 from microg.units import G0
@@ -241,3 +244,34 @@ def test_a_catalogue_is_refused_with_an_isolator_or_undamped_modes() -> None:
     with pytest.raises(InputError) as info:
         loads_study(CATALOGUE.replace("sources:example", "sources:nope.toml"), filename="s.toml")
     assert info.value.where == "s.toml: axes.force[1]"
+
+
+def test_an_imported_modal_models_grids_are_points_of_a_sweep(tmp_path) -> None:
+    # grid:N of a NASTRAN OP2 (tests/data/nastran/cla_residual.op2) is a point, as in
+    # microg.analyze; every case equals the analysis of it alone (result.analyze_case: the
+    # per-case path), to the kernel's 1e-9 (see _close)
+    op2 = Path(__file__).resolve().parents[1] / "data" / "nastran" / "cla_residual.op2"
+    text = f"""
+[study]
+name = "modal"
+model = {{ path = "{op2.as_posix()}", units = "in, lbf, s" }}
+[axes]
+force = ["crew-pushoff"]
+at = ["grid:3"]
+direction = ["x", "z"]
+observe = ["grid:3", "grid:24"]
+damping = [0.01]
+[record]
+duration = "60 s"
+dt = "0.005 s"
+"""
+    r = sweep(loads_study(text, filename="modal.toml"))
+    ds = r.dataset.load()
+    for idx in np.ndindex(*r.study.shape):
+        labels = r.study.case(idx)
+        ref = r.analyze_case(labels, isolation=False).observations[labels["observe"]]
+        got = ds.isel(dict(zip(CASE_DIMS, idx, strict=True)))
+        _close(got.peak_accel_g.values, ref.assessment.peak_accel_g, ref.assessment.peak_accel_g)
+    bad = text.replace('"grid:24"', '"grid:10"')
+    with pytest.raises(InputError, match="grid:N for a grid of the model"):
+        loads_study(bad, filename="modal.toml")

@@ -1119,12 +1119,14 @@ class _Builder:
                     used = sorted({i for cs in sets if im in cs[0] and iv in cs[1] for i in cs[k]})
                     for j in used:
                         p = getattr(study, name)[j]
-                        if p not in known:
+                        if p not in known and not _is_grid_of(model, p):
                             given = getattr(self.doc.axes, name) is not None
                             raise self.err(
                                 f"axes.{name}[{j}]" if given else f"axes.{name}",
                                 f"point {p!r} is not in model {label!r}",
-                                f"known points: {', '.join(known)}; or declare it in [[point]]",
+                                f"known points: {', '.join(known) or '(none)'}; "
+                                + ("grid:N for a grid of the model; " if _grids(model) else "")
+                                + "or declare it in [[point]]",
                             )
 
     def check_catalogues(self, study: Study) -> None:
@@ -1193,6 +1195,21 @@ def _point_names(model: Any) -> list[tuple[str, str]]:
     if isinstance(pts, Mapping):
         return [(n, getattr(p, "kind", "point")) for n, p in pts.items()]
     return [(p.name, getattr(p, "kind", "point")) for p in pts]
+
+
+def _grids(model: Any) -> set[str]:
+    """``grid:N`` of an imported modal model's grids or a frame model's nodes (else empty)."""
+    ids = getattr(model, "grid_ids", None)
+    if ids is not None:
+        return {f"grid:{int(g)}" for g in ids}
+    if type(model).__name__ == "GraphModel":
+        return {n.name for n in model.nodes}
+    return set()
+
+
+def _is_grid_of(model: Any, name: str) -> bool:
+    """True when ``name`` is ``grid:N`` of one of the model's grids (as analyze accepts)."""
+    return name.startswith("grid:") and name in _grids(model)
 
 
 def _is_vec(value: Any, dim: str) -> bool:
