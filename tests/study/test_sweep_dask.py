@@ -47,6 +47,23 @@ def _study():
     return loads_study(TEXT, filename="study.toml")
 
 
+#: a distributed test that has not finished in this time fails instead of hanging CI (each
+#: takes 2-10 s on the 2-core machine)
+HANG_S = 180
+
+
+@pytest.fixture(autouse=True)
+def _no_hang():
+    def hung(signum, frame):
+        raise TimeoutError(f"a distributed test ran past {HANG_S} s (a hang)")
+
+    old = signal.signal(signal.SIGALRM, hung)
+    signal.alarm(HANG_S)
+    yield
+    signal.alarm(0)
+    signal.signal(signal.SIGALRM, old)
+
+
 @pytest.fixture(scope="module")
 def serial():
     return sweep(_study()).dataset.load()

@@ -128,3 +128,31 @@ def test_memory_is_bounded_by_a_block() -> None:
     chunk = ds.band_rms_g.data.chunksize
     assert chunk[:5] == (1, 1, 1, 1, 1)
     assert chunk[5:] == (s.chunks[5], s.chunks[6], s.chunks[7], 3, ds.sizes["band"])
+
+
+def test_sigterm_stops_the_sweep_resumably(tmp_path):
+    # a batch system's time limit sends SIGTERM: the blocks written stay, the error says how
+    # to resume, and the same call then resumes them; the process's own handler is restored
+    import os
+    import signal
+
+    from microg.study import load_study
+
+    example = Path(__file__).resolve().parents[2] / "examples" / "study.toml"
+    study = load_study(example)
+    out = tmp_path / "out"
+    sent = []
+
+    def progress(done: int, total: int) -> None:
+        if done and not sent:
+            sent.append(done)
+            os.kill(os.getpid(), signal.SIGTERM)
+
+    before = signal.getsignal(signal.SIGTERM)
+    with pytest.raises(SweepIncompleteError) as err:
+        sweep(study, out, progress=progress)
+    assert "terminated (SIGTERM" in str(err.value) and "to resume" in str(err.value)
+    assert signal.getsignal(signal.SIGTERM) == before
+    again = sweep(study, out)
+    assert again.resumed_blocks > 0
+    assert bool(again.dataset.computed.all())

@@ -434,11 +434,6 @@ def _scatter(client: Any, data: Any, broadcast: bool) -> Any:
     raise AssertionError("unreachable")  # pragma: no cover
 
 
-def _alive(future: Any) -> bool:
-    """True when a scattered future's data is still held by the cluster."""
-    return getattr(future, "status", None) == "finished"
-
-
 def _distributed(runner: _Runner, client: Any, task_fn: TaskFn, threads: int) -> None:
     """The sweep on a Dask cluster (see the module docstring).
 
@@ -488,16 +483,13 @@ def _distributed(runner: _Runner, client: Any, task_fn: TaskFn, threads: int) ->
                     raise
                 if kind == "basis":
                     solve(key, attempt + 1)
-                else:  # the data may be gone with the worker: scatter again what is lost
-                    # (a future still alive is kept, so that the other tasks resubmitted on
-                    # it are not cancelled as "already forgotten"; replaced ones are held
-                    # until the sweep ends for the tasks still running on them)
-                    if not _alive(shared["plan"]):
-                        held.append(shared["plan"])
-                        shared["plan"] = _scatter(client, plan, True)
-                    if not _alive(basis_f[key]):
-                        held.append(basis_f[key])
-                        basis_f[key] = _scatter(client, bases[key], True)
+                else:  # the data may be gone with the worker: scatter it again (a future
+                    # that looks alive may name data the scheduler has forgotten, and a task
+                    # on it would wait forever); the replaced futures are held until the
+                    # sweep ends, for the tasks still running on them
+                    held.extend((shared["plan"], basis_f[key]))
+                    shared["plan"] = _scatter(client, plan, True)
+                    basis_f[key] = _scatter(client, bases[key], True)
                     submit(key, works, attempt + 1)
                 continue
             finally:
@@ -517,6 +509,34 @@ def _distributed(runner: _Runner, client: Any, task_fn: TaskFn, threads: int) ->
         for f in list(ac.futures):
             f.cancel()
         raise
+
+
+class _Terminated(KeyboardInterrupt):
+    """SIGTERM during a sweep (SLURM's and PBS's time limit): stop as on Ctrl-C."""
+
+
+@contextmanager
+def _terminate_as_interrupt() -> Iterator[None]:
+    """Turn SIGTERM into :class:`_Terminated` while the sweep runs (main thread only).
+
+    The blocks written so far stay in the store, marked as stopped, and the error says how to
+    resume; the previous handler is restored afterwards.
+    """
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def handler(signum: int, frame: Any) -> None:
+        raise _Terminated
+
+    old = signal.signal(signal.SIGTERM, handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, old)
 
 
 def _prepare_out(study: Study, out: Path) -> Path:
@@ -614,15 +634,18 @@ def sweep(
     task_fn = _task_fn or run_blocks
     runner.start()
     try:
-        if runner.todo:
-            if workers is None and scheduler is None:
-                _serial(runner, task_fn, threads)
-            else:
-                with _client(workers, scheduler, timeout_s) as client:
-                    _distributed(runner, client, task_fn, threads)
+        with _terminate_as_interrupt():
+            if runner.todo:
+                if workers is None and scheduler is None:
+                    _serial(runner, task_fn, threads)
+                else:
+                    with _client(workers, scheduler, timeout_s) as client:
+                        _distributed(runner, client, task_fn, threads)
     except InputError:
         store.set_state("stopped", cause="bad input")
         raise
+    except _Terminated:
+        raise runner.stopped("terminated (SIGTERM: a batch system's time limit?)") from None
     except KeyboardInterrupt:
         raise runner.stopped("interrupted") from None
     except Exception as exc:  # a failure part-way: keep what is written, say how to resume
