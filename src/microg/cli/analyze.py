@@ -72,7 +72,7 @@ def _weight_to_mass(text: str) -> str:
     multiple=True,
     help="Disturbance: crew-pushoff, crew-pushoff:f0=40lbf,t1=0.5s, a library activity "
     "(foot-pushoff-max, hand-pushoff-mean, ...) or a CSV file. Repeatable. "
-    f"[default: {DEFAULTS['force']}]",
+    f"[default: {DEFAULTS['force']}; none with --sources]",
 )
 @click.option(
     "--at",

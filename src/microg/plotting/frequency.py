@@ -151,7 +151,7 @@ def plot_contributions(
     ax.set_xlabel("band centre [Hz]")
     ax.set_ylabel("share of band mean square")
     ax.grid(True, axis="y", alpha=0.3)
-    if r.sources:
+    if r.sources and ax.get_legend_handles_labels()[0]:  # no source drawn: no empty legend
         ax.legend(fontsize="small", ncol=2)
     return _finish(fig, bottom=1.0)  # room for the slanted band labels
 
