@@ -29,6 +29,7 @@ import hashlib
 import json
 import os
 import re
+import secrets
 import shutil
 import signal
 import sys
@@ -416,9 +417,15 @@ def write_run_directory(
         try:
             parent.mkdir(parents=True, exist_ok=True)
             _remove_stale(target)
-            tmp = Path(
-                tempfile.mkdtemp(prefix=f".{target.name}{_TMP_TAG}{os.getpid()}-", dir=parent)
-            )
+            # the name is held before the directory exists: a SIGTERM between the two (an
+            # exception at any bytecode) still finds it to remove (mkdtemp's return would not)
+            while True:
+                tmp = parent / f".{target.name}{_TMP_TAG}{os.getpid()}-{secrets.token_hex(4)}"
+                try:
+                    os.mkdir(tmp, 0o700)
+                    break
+                except FileExistsError:
+                    continue
             (tmp / f"{RUN_MARKER}.pending").write_bytes(b"")
             for name, content in files.items():
                 data = content.encode("utf-8") if isinstance(content, str) else bytes(content)
