@@ -50,6 +50,7 @@ __all__ = [
     "check_writable",
     "dumps",
     "safe_filenames",
+    "sigterm_raises",
     "to_jsonable",
     "write_output_files",
     "write_run_directory",
@@ -346,24 +347,36 @@ class _Terminated(BaseException):
 
 
 @contextlib.contextmanager
-def _sigterm_as_exception() -> Iterator[None]:
-    """Turn SIGTERM into an exception inside the block (main thread only), then re-deliver it."""
+def sigterm_raises(exc_type: type[BaseException]) -> Iterator[Any]:
+    """Inside the block, SIGTERM raises ``exc_type`` (main thread only); restored after.
+
+    Yields the handler the block replaced (``signal.SIG_DFL`` if none), for a caller that
+    re-delivers the signal once it has cleaned up.
+    """
     if threading.current_thread() is not threading.main_thread():
-        yield
+        yield signal.getsignal(signal.SIGTERM) or signal.SIG_DFL
         return
 
     def handler(signum: int, frame: Any) -> None:
-        raise _Terminated
+        raise exc_type
 
     previous = signal.signal(signal.SIGTERM, handler) or signal.SIG_DFL
     try:
-        yield
-    except _Terminated:
-        signal.signal(signal.SIGTERM, previous)
-        signal.raise_signal(signal.SIGTERM)  # the previous handler (default: terminate)
-        raise KeyboardInterrupt from None  # pragma: no cover - a handler that returned
+        yield previous
     finally:
         signal.signal(signal.SIGTERM, previous)
+
+
+@contextlib.contextmanager
+def _sigterm_as_exception() -> Iterator[None]:
+    """Turn SIGTERM into an exception inside the block (main thread only), then re-deliver it."""
+    with sigterm_raises(_Terminated) as previous:
+        try:
+            yield
+        except _Terminated:
+            signal.signal(signal.SIGTERM, previous)
+            signal.raise_signal(signal.SIGTERM)  # the previous handler (default: terminate)
+            raise KeyboardInterrupt from None  # pragma: no cover - a handler that returned
 
 
 def _check_names(files: Mapping[str, bytes | str], where: str) -> None:

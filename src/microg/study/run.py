@@ -29,6 +29,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from microg._io import sigterm_raises
 from microg.errors import InputError, MicrogError
 from microg.study.kernel import Basis, BlockWork, KernelPlan, kernel_plan, run_blocks, solve_basis
 from microg.study.plan import Block, Study, default_n_modes, load_study
@@ -512,31 +513,7 @@ def _distributed(runner: _Runner, client: Any, task_fn: TaskFn, threads: int) ->
 
 
 class _Terminated(KeyboardInterrupt):
-    """SIGTERM during a sweep (SLURM's and PBS's time limit): stop as on Ctrl-C."""
-
-
-@contextmanager
-def _terminate_as_interrupt() -> Iterator[None]:
-    """Turn SIGTERM into :class:`_Terminated` while the sweep runs (main thread only).
-
-    The blocks written so far stay in the store, marked as stopped, and the error says how to
-    resume; the previous handler is restored afterwards.
-    """
-    import signal
-    import threading
-
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-
-    def handler(signum: int, frame: Any) -> None:
-        raise _Terminated
-
-    old = signal.signal(signal.SIGTERM, handler)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGTERM, old)
+    """SIGTERM during a sweep (SLURM's and PBS's time limit): stop as on Ctrl-C, resumably."""
 
 
 def _prepare_out(study: Study, out: Path) -> Path:
@@ -634,7 +611,7 @@ def sweep(
     task_fn = _task_fn or run_blocks
     runner.start()
     try:
-        with _terminate_as_interrupt():
+        with sigterm_raises(_Terminated):
             if runner.todo:
                 if workers is None and scheduler is None:
                     _serial(runner, task_fn, threads)
