@@ -169,28 +169,7 @@ class SweepResult:
         d = s.directions[s.coords["direction"].index(case["direction"])]
         disc, rec = s.discretisation, s.record
         n_modes = disc.n_modes or default_n_modes(s)
-        if f.catalogue is not None:
-            return analyze(
-                self.case_model(case["model"], case["variant"]),
-                sources=f.catalogue,
-                observe=[case["observe"]],
-                method=disc.method,
-                plane=disc.plane,
-                n=disc.n,
-                n_modes=n_modes,
-                gravity_gradient=disc.gravity_gradient,
-                damping=float(case["damping"]),
-                duration=rec.duration_s,
-                dt=rec.dt_s,
-                max_freq=rec.max_freq_hz,
-                requirement=rec.requirement,
-                **kwargs,
-            )
-        return analyze(
-            self.case_model(case["model"], case["variant"]),
-            force=f.spec,
-            at=case["at"],
-            direction=d.vector,
+        common: dict[str, Any] = dict(
             observe=[case["observe"]],
             method=disc.method,
             plane=disc.plane,
@@ -202,8 +181,11 @@ class SweepResult:
             dt=rec.dt_s,
             max_freq=rec.max_freq_hz,
             requirement=rec.requirement,
-            **kwargs,
         )
+        model = self.case_model(case["model"], case["variant"])
+        if f.catalogue is not None:
+            return analyze(model, sources=f.catalogue, **common, **kwargs)
+        return analyze(model, force=f.spec, at=case["at"], direction=d.vector, **common, **kwargs)
 
 
 # ----------------------------------------------------------------------------- planning
