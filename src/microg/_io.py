@@ -50,6 +50,7 @@ __all__ = [
     "check_writable",
     "dumps",
     "safe_filenames",
+    "loads_toml",
     "sigterm_raises",
     "to_jsonable",
     "write_output_files",
@@ -59,6 +60,33 @@ __all__ = [
 #: name of the marker file of a run directory
 RUN_MARKER = ".microg-run"
 _TMP_TAG = ".microg-tmp-"
+
+
+_TOML_POS = re.compile(r"\s*\(at line (\d+), column (\d+)\)\s*$")
+
+
+def loads_toml(text: str, filename: str, error: type[InputError] = InputError) -> dict[str, Any]:
+    """``tomllib.loads``, a syntax error as one line naming ``filename: line L, column C``.
+
+    Parameters
+    ----------
+    text : the TOML text
+    filename : the file named in the error
+    error : the error type raised (``ModelError`` for model files)
+    """
+    import tomllib
+
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        msg = str(exc)
+        m = _TOML_POS.search(msg)
+        where = f"{filename}: line {m.group(1)}, column {m.group(2)}" if m else filename
+        raise error(
+            f"invalid TOML: {' '.join(_TOML_POS.sub('', msg).split())}",
+            where=where,
+            fix="fix the TOML syntax there",
+        ) from None
 
 
 def to_jsonable(obj: Any) -> Any:

@@ -42,7 +42,6 @@ from __future__ import annotations
 
 import math
 import re
-import tomllib
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from importlib import resources
@@ -51,6 +50,7 @@ from typing import Any
 
 import numpy as np
 
+from microg._io import loads_toml
 from microg._vectors import DIRECTION_FIX, parse_direction
 from microg.dynamics.frequency import (
     BandForceSpectrum,
@@ -106,7 +106,6 @@ _STATES = ("on", "off")
 _EXAMPLE = "example_sources.toml"
 #: a force-PSD unit: force unit, power 2, "/", frequency unit (``N^2/Hz``, ``(lbf)**2 / Hz``)
 _PSD_UNIT = re.compile(r"^\s*\(?\s*([^()^*/\s]+)\s*\)?\s*(?:\^|\*\*)\s*2\s*/\s*([^()^*/\s]+)\s*$")
-_TOML_POS = re.compile(r"\s*\(at line (\d+), column (\d+)\)")
 
 
 # ---------------------------------------------------------------------------- band centres
@@ -727,17 +726,7 @@ def loads_sources(text: str, filename: str = "<sources>") -> SourceCatalogue:
     InputError
         One line naming ``filename``, the source and field, and the fix.
     """
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        msg = str(exc)
-        pos = _TOML_POS.search(msg)
-        where = f"{filename}: line {pos.group(1)}, column {pos.group(2)}" if pos else filename
-        raise InputError(
-            f"invalid TOML: {' '.join(_TOML_POS.sub('', msg).split())}",
-            where=where,
-            fix="fix the TOML syntax there",
-        ) from None
+    data = loads_toml(text, filename)
     return _Reader(filename).catalogue(data)
 
 

@@ -26,7 +26,6 @@ from __future__ import annotations
 
 import math
 import re
-import tomllib
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -34,6 +33,7 @@ from typing import Any
 
 import numpy as np
 
+from microg._io import loads_toml
 from microg.errors import InputError, ModelError
 
 __all__ = [
@@ -1324,12 +1324,7 @@ def spring_axes(
 
 def loads_graph(text: str, *, filename: str = "<string>") -> GraphModel:
     """Read a graph model from TOML text (format: ``docs/model-format.md``, "Graph models")."""
-    try:
-        doc = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ModelError(
-            f"invalid TOML: {exc}", where=filename, fix="fix the TOML syntax there"
-        ) from None
+    doc = loads_toml(text, filename, ModelError)
     if "graph" not in doc or not isinstance(doc["graph"], dict):
         raise ModelError(
             "missing [graph] table", where=filename, fix="start the file with [graph] and a name"

@@ -50,7 +50,6 @@ from __future__ import annotations
 
 import io
 import json
-import tomllib
 import zipfile
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
@@ -59,6 +58,7 @@ from typing import Any
 
 import numpy as np
 
+from microg._io import loads_toml
 from microg.errors import InputError, ModelError
 from microg.units import parse_quantity
 
@@ -294,10 +294,7 @@ def read_options(path: str | Path) -> ModelOptions:
         raise ModelError("no such file", where=label, fix="give the points file's path") from None
     except (OSError, UnicodeDecodeError) as exc:
         raise ModelError(f"cannot read: {exc}", where=label) from None
-    try:
-        doc = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ModelError(f"not valid TOML: {exc}", where=label) from None
+    doc = loads_toml(text, label, ModelError)
     known = {"units", "wtmass", "points"}
     extra = sorted(set(doc) - known)
     if extra:

@@ -22,12 +22,12 @@ station back as TOML in SI units, such that ``loads_station(dump_station(st))`` 
 from __future__ import annotations
 
 import re
-import tomllib
 from pathlib import Path
 
 import numpy as np
 from pydantic import ValidationError
 
+from microg._io import loads_toml
 from microg.errors import ModelError
 from microg.models.build import build_station
 from microg.models.catalog import shipped_model_text, shipped_models
@@ -57,7 +57,6 @@ MAX_NESTING = 8
 #: most parts of a dotted key or table name (``body.mass`` has 2)
 MAX_KEY_PARTS = 8
 
-_TOML_POS = re.compile(r"\s*\(at line (\d+), column (\d+)\)\s*$")
 # strings and comments (their brackets and dots do not count); multi-line forms first
 _STRINGS = re.compile(
     r'"""[\s\S]*?"""|\'\'\'[\s\S]*?\'\'\'|"(?:[^"\\\n]|\\.)*"|\'[^\'\n]*\'|#[^\n]*'
@@ -149,15 +148,9 @@ def loads_station(text: str, *, filename: str = "<string>", source: str = "") ->
         text = text[1:]
     _prescan(text, filename)
     try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        msg = str(exc)
-        m = _TOML_POS.search(msg)
-        where = f"{filename}: line {m.group(1)}, column {m.group(2)}" if m else filename
-        msg = _TOML_POS.sub("", msg)
-        raise ModelError(
-            f"invalid TOML: {' '.join(msg.split())}", where=where, fix="fix the TOML syntax there"
-        ) from None
+        data = loads_toml(text, filename, ModelError)
+    except ModelError:  # a syntax error, already one line (ModelError is a ValueError too)
+        raise
     except RecursionError:
         raise ModelError(
             "nested too deeply", where=filename, fix="the format nests at most two levels"

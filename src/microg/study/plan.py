@@ -36,7 +36,6 @@ import dataclasses
 import hashlib
 import math
 import re
-import tomllib
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -53,6 +52,7 @@ from pydantic import (
     ValidationError,
 )
 
+from microg._io import loads_toml
 from microg._vectors import axis_name, parse_direction
 from microg.analysis import DEFAULTS
 from microg.dynamics.forces import ForceHistory, activity_library, parse_force_spec
@@ -609,9 +609,6 @@ def load_study(path: str | Path) -> Study:
     return loads_study(text, filename=label, base_dir=p.resolve().parent)
 
 
-_TOML_POS = re.compile(r"\s*\(at line (\d+), column (\d+)\)")
-
-
 def loads_study(text: str, *, filename: str = "<study>", base_dir: str | Path = ".") -> Study:
     """Validate the text of a study file.
 
@@ -625,17 +622,7 @@ def loads_study(text: str, *, filename: str = "<study>", base_dir: str | Path = 
     -------
     Study
     """
-    try:
-        raw = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        msg = str(exc)
-        m = _TOML_POS.search(msg)
-        where = f"{filename}: line {m.group(1)}, column {m.group(2)}" if m else filename
-        raise InputError(
-            f"invalid TOML: {' '.join(_TOML_POS.sub('', msg).split())}",
-            where=where,
-            fix="fix the TOML syntax there",
-        ) from None
+    raw = loads_toml(text, filename)
     if isinstance(raw.get("axes"), dict):
         known = set(AxesIn.model_fields)
         for key in raw["axes"]:
