@@ -34,7 +34,7 @@ from microg.dynamics.response import (
     modal_pwl_response,
     peak_response,
 )
-from microg.environment.metrics import Assessment, acceleration_psd, assess, band_rms
+from microg.environment.metrics import Assessment, assess, band_mean_square
 from microg.environment.requirements import (
     BandTable,
     Requirement,
@@ -973,7 +973,6 @@ class _ModalSeries:
         self.t = t
         self.acc = acc
         self._peak: np.ndarray | None = None
-        self._spec: Any = None
         self._band: dict[float, np.ndarray] = {}
 
     def peak_abs(self) -> np.ndarray:
@@ -986,10 +985,9 @@ class _ModalSeries:
         """RMS of each modal acceleration in one band, m/s^2 (k,)."""
         key = float(center_hz)
         if key not in self._band:
-            if self._spec is None:
-                self._spec = acceleration_psd(self.t, self.acc)
             bands = BandTable(np.array([center_hz]), np.array([lower_hz]), np.array([upper_hz]))
-            self._band[key] = band_rms(self._spec, bands).rms[:, 0]
+            ms = band_mean_square(self.t, self.acc, bands)[:, 0]
+            self._band[key] = np.sqrt(np.maximum(ms, 0.0))
         return self._band[key]
 
 
@@ -1063,6 +1061,47 @@ def _intervals(t: np.ndarray, accel: np.ndarray, req: Requirement) -> dict[str, 
     }
 
 
+class _Provenance:
+    """The provenance record of a run, its model file hashed in a background thread.
+
+    A modal model's file can be hundreds of MB (issue 11: 193 MB for 20,000 grids x 200
+    modes), a quarter of a second of SHA-256; hashlib and file reads release the GIL, so the
+    hash runs beside the computation instead of after it.  :meth:`result` joins the thread
+    and re-raises anything it raised.
+    """
+
+    def __init__(self, model: Any, command: str | None):
+        import threading
+
+        self._out: dict[str, Any] = {}
+        self._error: BaseException | None = None
+
+        def work() -> None:
+            try:
+                self._out = _meta(model, command)
+            except BaseException as exc:  # re-raised in the caller's thread by result()
+                self._error = exc
+
+        self._thread = threading.Thread(target=work, name="microg-provenance", daemon=True)
+        self._thread.start()
+
+    def result(self) -> dict[str, Any]:
+        """The record (:func:`_meta`), once the hash is done."""
+        self._thread.join()
+        if self._error is not None:
+            raise self._error
+        return self._out
+
+
+def _sha256_file(path: Path) -> str:
+    """SHA-256 of a file, read in 8-MiB blocks (never the whole file in memory at once)."""
+    h = hashlib.sha256()
+    with path.open("rb") as fh:
+        while block := fh.read(1 << 23):
+            h.update(block)
+    return h.hexdigest()
+
+
 def _meta(model: Any, command: str | None) -> dict[str, Any]:
     from microg import __version__
 
@@ -1073,7 +1112,7 @@ def _meta(model: Any, command: str | None) -> dict[str, Any]:
         p = Path(src)
         if p.is_file():
             path = str(p.resolve())
-            sha = hashlib.sha256(p.read_bytes()).hexdigest()
+            sha = _sha256_file(p)
         else:
             path = src
             try:
@@ -1117,6 +1156,7 @@ def run_analysis(
     step = progress or (lambda _s: None)
     _check_record(opts)
     req = requirement or _requirement(opts.requirement)
+    provenance = _Provenance(model, command)
     step("structure")
     structure = _structure(model, opts)
     for d in opts.disturbances:
@@ -1164,7 +1204,7 @@ def run_analysis(
         requirement=req,
         warnings=warnings,
         notes=notes,
-        meta=_meta(model, command),
+        meta=provenance.result(),
         frequency_domain=vib,
     )
 

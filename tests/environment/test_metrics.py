@@ -21,6 +21,7 @@ from scipy import integrate
 from microg.environment.metrics import (
     acceleration_psd,
     assess,
+    band_mean_square,
     band_rms,
     integrated_acceleration,
     integrated_acceleration_pims,
@@ -506,3 +507,45 @@ def test_band_weights_integrate_the_piecewise_constant_psd_exactly():
         np.testing.assert_allclose(
             band_rms(spec, bands).rms, np.sqrt(ref[:, keep]), rtol=1e-12, atol=1e-15
         )
+
+
+@pytest.mark.parametrize("n", [20001, 4096, 1000, 17])
+@pytest.mark.parametrize("wide", [False, True])
+def test_band_mean_square_equals_the_periodogram_band_sum(n, wide):
+    """Both paths (direct DFT of a few bins; the whole FFT) give W @ periodogram.
+
+    Reference: ``band_rms(acceleration_psd(...))`` (numpy's FFT), the definition itself.
+    Tolerance 1e-11 relative to the largest band: the direct sums of n terms round to
+    ~sqrt(n) eps of |x|^2 n.
+    """
+    rng = np.random.default_rng(n)
+    fs = 100.0
+    t = np.arange(n) / fs
+    x = rng.standard_normal((7, n)) + 3.0  # a mean, which neither path counts
+    df = fs / n
+    if wide:
+        bands = third_octave_bands(0.01, 50.0)  # many bins: the whole-FFT path
+    else:  # three narrow bands, a few bins each, edges between bins: the direct path
+        lo = np.array([3.3, 11.1, 20.05]) * df + 0.1
+        bands = BandTable(lo, lo, lo + np.array([4.6, 2.3, 9.9]) * df)
+    got = band_mean_square(t, x, bands)
+    ref = band_rms(acceleration_psd(t, x), bands).rms ** 2
+    keep = bands.lower_hz < fs / 2
+    assert got.shape == (7, bands.center_hz.size)
+    np.testing.assert_allclose(got[:, keep], ref, rtol=0, atol=1e-11 * ref.max())
+    assert np.all(got[:, ~keep] == 0.0)
+
+
+def test_band_mean_square_of_a_bin_centred_sine_is_half_its_square():
+    """Exact: a sine of amplitude A on bin k of a boxcar record has mean square A^2 / 2.
+
+    All of it falls in bin k (no leakage), so any band holding the whole bin returns
+    A^2 / 2 to rounding (1e-12).
+    """
+    n, fs, k, amp = 20001, 100.0, 40, 3.0
+    t = np.arange(n) / fs
+    f0 = k * fs / n
+    x = amp * np.sin(2 * np.pi * f0 * t)
+    bands = BandTable(np.array([f0]), np.array([f0 * 0.9]), np.array([f0 * 1.1]))
+    got = band_mean_square(t, x, bands)
+    assert got[0, 0] == pytest.approx(amp**2 / 2, rel=1e-12)
