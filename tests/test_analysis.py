@@ -486,3 +486,21 @@ def test_a_negative_duration_is_blamed_on_the_duration():
     with pytest.raises(microg.InputError) as err:
         microg.analyze("ioc", duration="-200 s")
     assert err.value.where == "duration" and "must be > 0" in str(err.value)
+
+
+def test_provenance_hash_of_a_file_read_in_blocks(tmp_path) -> None:
+    # reference: hashlib over the whole file at once; the file (> 8 MiB, one block and a
+    # piece) is hashed by the library in blocks, in a background thread
+    import hashlib
+
+    from microg.analysis import _Provenance
+
+    class FileModel:
+        source = str(tmp_path / "big.bin")
+
+    data = np.random.default_rng(0).bytes((1 << 23) + 12345)
+    (tmp_path / "big.bin").write_bytes(data)
+    meta = _Provenance(FileModel(), "microg analyze big.bin").result()
+    assert meta["model_sha256"] == hashlib.sha256(data).hexdigest()
+    assert meta["model_path"] == str((tmp_path / "big.bin").resolve())
+    assert meta["command"] == "microg analyze big.bin"
