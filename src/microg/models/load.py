@@ -17,12 +17,14 @@ argument or the points file; a missing declaration is an error, never a guess.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from microg.errors import InputError
-from microg.models.modal import ModelOptions, load_modal_model, parse_units, read_options
+
+if TYPE_CHECKING:
+    from microg.models.modal import ModelOptions
 
 __all__ = ["load_model", "MODEL_SUFFIXES"]
 
@@ -42,6 +44,8 @@ def _units(
                 fix='state them, e.g. units="in, lbf, s" (or in the points file)',
             )
         return None
+    from microg.models.modal import parse_units
+
     return parse_units(text, where="units", wtmass=wt)
 
 
@@ -68,10 +72,17 @@ def load_model(
     -------
     ModalModel or Station
     """
-    opts = read_options(points) if points is not None else ModelOptions()
     p = Path(path)
     suffix = p.suffix.lower()
     label = str(path)
+    if points is None and (suffix == ".toml" or suffix not in MODEL_SUFFIXES):
+        # a station (a file or a shipped name): the modal readers are not needed
+        from microg.models.toml import load_station
+
+        return load_station(p if suffix == ".toml" else path)
+    from microg.models.modal import ModelOptions, load_modal_model, read_options
+
+    opts = read_options(points) if points is not None else ModelOptions()
     if suffix not in MODEL_SUFFIXES:
         from microg.models.toml import load_station
 

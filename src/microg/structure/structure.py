@@ -8,18 +8,28 @@ frame finite elements in :mod:`microg.structure.fem`) produce, and what
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-import scipy.sparse as sp
 
 from microg.errors import InputError
 
 __all__ = ["PointMap", "Structure"]
 
 Matrix = Any  # numpy.ndarray or scipy.sparse matrix
+
+
+def _issparse(a: Any) -> bool:
+    """``scipy.sparse.issparse(a)``, without importing scipy for a dense structure.
+
+    A scipy sparse matrix cannot exist before :mod:`scipy.sparse` is imported, so when it is
+    not loaded the answer is False (the Ritz and modal structures never load it).
+    """
+    sp = sys.modules.get("scipy.sparse")
+    return sp is not None and bool(sp.issparse(a))
 
 
 @dataclass(frozen=True)
@@ -103,7 +113,7 @@ class Structure:
     @property
     def is_sparse(self) -> bool:
         """True when the matrices are scipy sparse."""
-        return sp.issparse(self.mass)
+        return _issparse(self.mass)
 
     def point(self, name: str) -> PointMap:
         """The named point's map; an unknown name is an :class:`InputError` listing the known."""
@@ -115,6 +125,6 @@ class Structure:
 
     def dense(self) -> tuple[np.ndarray, np.ndarray]:
         """Mass and stiffness as dense arrays."""
-        m = self.mass.toarray() if sp.issparse(self.mass) else np.asarray(self.mass)
-        k = self.stiffness.toarray() if sp.issparse(self.stiffness) else np.asarray(self.stiffness)
+        m = self.mass.toarray() if _issparse(self.mass) else np.asarray(self.mass)
+        k = self.stiffness.toarray() if _issparse(self.stiffness) else np.asarray(self.stiffness)
         return m, k
