@@ -233,9 +233,8 @@ def analyze(
     the observed points against the ISS vibratory requirement, and advises isolation.
     Writes OUT/report.html (self-contained), PNG figures and OUT/results.json.
     """
-    from tqdm import tqdm
-
     import microg
+    from microg.cli._progress import progress_bar
     from microg.errors import InputError
 
     _check_out(out_dir)
@@ -261,7 +260,7 @@ def analyze(
     if package_mass is not None:
         kwargs["package_mass"] = package_mass
     stages = ["structure", "modes", "response", "assessment", "isolation", "report"]
-    bar = tqdm(total=len(stages), desc="microg analyze", disable=no_progress or None, leave=False)
+    bar = progress_bar(len(stages), "microg analyze", hide=no_progress)
 
     def progress(stage: str) -> None:
         bar.set_postfix_str(stage)

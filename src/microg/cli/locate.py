@@ -486,8 +486,7 @@ def optimize(
     Objective (report conclusion 9): the site's peak acceleration over time, rigid-body
     modes included (--measure), on the assumed-modes model of each trial layout.
     """
-    from tqdm import tqdm
-
+    from microg.cli._progress import progress_bar
     from microg.location.layout import optimize_layout
     from microg.models.toml import load_station
 
@@ -495,9 +494,7 @@ def optimize(
         crew = _crew(f0, t1, t13, t14)
     station = load_station(model)
     overrides = {name: (lo, hi) for name, lo, hi in movable}
-    bar = tqdm(
-        total=maxiter, desc="microg optimize", unit="gen", disable=no_progress or None, leave=False
-    )
+    bar = progress_bar(maxiter, "microg optimize", hide=no_progress, unit="gen")
 
     def progress(generation: int, total: int) -> None:
         bar.update(generation - bar.n)

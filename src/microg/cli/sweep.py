@@ -89,9 +89,8 @@ def sweep(
     goes and OUT/report.html (worst cases, margin heat map, complying fraction, and the microg
     analyze command that reproduces any case).
     """
-    from tqdm import tqdm
-
     from microg._io import atomic_write_text, dumps
+    from microg.cli._progress import progress_bar
     from microg.errors import InputError
     from microg.study import load_study
     from microg.study.run import SweepIncompleteError
@@ -110,13 +109,7 @@ def sweep(
     study = load_study(study_file)
     with flag_errors(FLAGS):
         dims = check_heatmap(study, heatmap.split(",") if heatmap else None)
-    bar = tqdm(
-        total=study.n_cases,
-        desc=f"microg sweep {study.name}",
-        unit="case",
-        disable=no_progress or None,
-        leave=False,
-    )
+    bar = progress_bar(study.n_cases, f"microg sweep {study.name}", hide=no_progress, unit="case")
 
     def progress(done: int, total: int) -> None:
         bar.update(done - bar.n)
