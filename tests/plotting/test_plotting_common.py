@@ -1,9 +1,9 @@
 """The lean figure machinery of microg.plotting.common (issue 8, "Speed of the main job").
 
 References: a brute-force slice-by-slice min/max for the drawing envelope; matplotlib's own
-LogFormatterSciNotation labels for the Unicode log labels; matplotlib's own minor ticks (the
-same figure drawn both ways) for the lean minor ticks; matplotlib's measured text extents for
-the fixed margins.
+LogFormatterSciNotation labels for the Unicode log labels; matplotlib's own Axis objects (the
+same figure drawn both ways) for the lean axes; matplotlib's PNG writer and PIL's decoder for
+the PNG encoder; matplotlib's measured text extents for the fixed margins.
 """
 
 from __future__ import annotations
@@ -19,7 +19,15 @@ from matplotlib.figure import Figure
 from matplotlib.ticker import LogFormatterSciNotation
 from PIL import Image
 
-from microg.plotting.common import PlainLogFormatter, envelope, finish, new_figure
+from microg.plotting.common import (
+    PlainLogFormatter,
+    encode_png,
+    envelope,
+    finish,
+    new_figure,
+    plain_axes,
+    png_bytes,
+)
 
 
 def _brute_envelope_values(y: np.ndarray, bins: int) -> list[tuple[float, float]]:
@@ -128,28 +136,104 @@ def _loglog_figure() -> Figure:
     f = np.logspace(-2, 2.5, 200)
     ax.loglog(f, 1e-3 / (1 + f**2), lw=0.8, label="x")
     ax.grid(True, which="both", alpha=0.3)
+    ax.set_xlabel("frequency [Hz]")
+    ax.set_ylabel("PSD [g^2/Hz]")
+    ax.set_title("a log-log figure")
     ax.legend()
     return fig
 
 
-def test_lean_minor_ticks_draw_as_matplotlibs():
-    # reference: the same figure with matplotlib's Tick objects for the minor ticks and grid
-    lean = finish(_loglog_figure())
-    plain = _loglog_figure()  # the same labels and margins, matplotlib's own minor ticks
-    for axis in plain.axes[0].xaxis, plain.axes[0].yaxis:
-        axis.set_major_formatter(PlainLogFormatter())
-        axis.set_minor_formatter(PlainLogFormatter(labelOnlyBase=False))
-    p = lean.subplotpars
-    plain.subplots_adjust(left=p.left, right=p.right, bottom=p.bottom, top=p.top)
-    assert len(lean.axes[0].xaxis.get_minorticklocs()) == 0  # ours: no minor Tick objects
-    assert len(plain.axes[0].xaxis.get_minorticklocs()) > 10
+def _linear_figure() -> Figure:
+    fig = new_figure(6.0, 4.0)
+    ax = fig.add_subplot()
+    t = np.linspace(0.0, 200.0, 500)
+    ax.plot(t, 60.0 * np.sin(t / 7.0), lw=0.8, label="x")
+    ax.plot(t, -40.0 * np.cos(t / 3.0), lw=0.8, label="y")
+    ax.grid(True, alpha=0.3)
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("acceleration [micro-g]")
+    ax.set_title("a linear figure")
+    ax.legend(fontsize=8)
+    return fig
+
+
+def _narrow_log_and_offset_figure() -> Figure:
+    # minor log labels (less than 1.5 decades) above, an offset text ("1e5") below
+    fig = new_figure(6.0, 6.0)
+    ax1, ax2 = fig.subplots(2, 1)
+    ax1.loglog([1.0, 5.0], [2.0, 30.0], "o-")
+    ax1.grid(True, which="both", alpha=0.3)
+    ax1.set_xlabel("f [Hz]")
+    ax1.set_ylabel("rms")
+    t = np.linspace(0.0, 1.0, 50)
+    ax2.plot(t, 1e5 + t, label="drift")
+    ax2.set_xlabel("time [s]")
+    ax2.set_ylabel("counts")
+    ax2.set_title("an offset text")
+    return fig
+
+
+def _matplotlibs(build):  # the same figure, finished, drawn by matplotlib's own Axis objects
+    return plain_axes(finish(build()))
+
+
+@pytest.mark.parametrize("build", [_loglog_figure, _linear_figure, _narrow_log_and_offset_figure])
+def test_lean_axes_draw_as_matplotlibs(build):
+    # reference: the same figure drawn by matplotlib's own Axis (Tick objects), same margins
+    lean, plain = finish(build()), _matplotlibs(build)
+    assert not lean.axes[0].xaxis.get_visible()  # ours: the Axis is hidden, no Tick drawn
+    assert plain.axes[0].xaxis.get_visible()
     ours, theirs = _pixels(lean), _pixels(plain)
     assert ours.shape == theirs.shape
     diff = np.abs(ours - theirs).max(axis=2)
-    # anti-aliasing of a line drawn by a collection rather than one Line2D per tick may
-    # differ by a grey level or two; no pixel may differ visibly
+    # anti-aliasing of grid lines drawn by one collection rather than one Line2D per tick
+    # may differ by a grey level or two; no pixel may differ visibly, and text (tick labels,
+    # axis labels, offset text, title) lands on the same pixels
     assert diff.max() <= 8, diff.max()
     assert np.count_nonzero(diff) <= 1e-3 * diff.size
+
+
+def test_lean_axes_follow_later_changes():
+    # reference: matplotlib's own Axis after the same changes made after finish()
+    def changed(fig: Figure) -> Figure:
+        ax = fig.axes[0]
+        ax.set_xlim(0.1, 10.0)
+        ax.set_xticks([0.2, 1.0, 5.0])
+        ax.set_xlabel("new label")
+        return fig
+
+    ours = _pixels(changed(finish(_loglog_figure())))
+    theirs = _pixels(changed(_matplotlibs(_loglog_figure)))
+    diff = np.abs(ours - theirs).max(axis=2)
+    assert diff.max() <= 8 and np.count_nonzero(diff) <= 1e-3 * diff.size
+
+
+def test_png_bytes_are_matplotlibs_pixels():
+    # reference: matplotlib's own PNG writer (savefig), decoded by PIL, pixel for pixel
+    fig = finish(_linear_figure())
+    png = png_bytes(fig, dpi=80)
+    assert png[:8] == b"\x89PNG\r\n\x1a\n"
+    ours = np.asarray(Image.open(io.BytesIO(png)).convert("RGBA"), int)
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=80)
+    theirs = np.asarray(Image.open(io.BytesIO(buf.getvalue())).convert("RGBA"), int)
+    assert np.array_equal(ours, theirs)
+    assert fig.dpi == 100 and type(fig.canvas).__name__ == "FigureCanvasBase"  # left as found
+
+
+@given(
+    arrays(np.uint8, st.tuples(st.integers(1, 9), st.integers(1, 9), st.just(4))),
+    st.booleans(),
+    st.integers(0, 9),
+)
+def test_encode_png_round_trips(rgba, opaque, level):
+    # reference: PIL's PNG decoder; every pixel comes back (RGBA, or RGB when opaque)
+    if opaque:
+        rgba = rgba.copy()
+        rgba[:, :, 3] = 255
+    back = np.asarray(Image.open(io.BytesIO(encode_png(rgba, level))).convert("RGBA"))
+    assert np.array_equal(back, rgba)
+    assert Image.open(io.BytesIO(encode_png(rgba))).mode == ("RGB" if opaque else "RGBA")
 
 
 def test_report_figures_keep_every_label_inside():
