@@ -173,11 +173,27 @@ def _narrow_log_and_offset_figure() -> Figure:
     return fig
 
 
+def _rotated_labels_figure() -> Figure:
+    # bars with fixed, slanted tick labels (as the source-contribution figure draws them)
+    fig = new_figure(6.0, 4.0, margins={"bottom": 1.0})
+    ax = fig.add_subplot()
+    x = np.arange(12)
+    ax.bar(x, np.linspace(0.1, 1.0, 12), label="pump")
+    ax.set_xticks(x[::3], [f"{c:.3g}" for c in np.logspace(-1, 1, 12)[::3]], rotation=60)
+    ax.set_xlabel("band centre [Hz]")
+    ax.grid(True, axis="y", alpha=0.3)
+    ax.legend(fontsize="small")
+    return fig
+
+
 def _matplotlibs(build):  # the same figure, finished, drawn by matplotlib's own Axis objects
     return plain_axes(finish(build()))
 
 
-@pytest.mark.parametrize("build", [_loglog_figure, _linear_figure, _narrow_log_and_offset_figure])
+@pytest.mark.parametrize(
+    "build",
+    [_loglog_figure, _linear_figure, _narrow_log_and_offset_figure, _rotated_labels_figure],
+)
 def test_lean_axes_draw_as_matplotlibs(build):
     # reference: the same figure drawn by matplotlib's own Axis (Tick objects), same margins
     lean, plain = finish(build()), _matplotlibs(build)

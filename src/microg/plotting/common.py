@@ -355,17 +355,19 @@ class _LeanAxis(Artist):
         ax = self._ax
         pad = tick.get_pad() + tick.get_tick_padding()
         get = ax.get_xaxis_text1_transform if self._is_x else ax.get_yaxis_text1_transform
-        trans, va, ha = get(pad)
-        src = tick.label1
+        trans, _, _ = get(pad)
+        src = tick.label1  # the axis' label style, alignment and rotation included
         text = Text(
             0.0,
             0.0,
             "",
             fontproperties=src.get_fontproperties(),
             color=src.get_color(),
-            verticalalignment=va,
-            horizontalalignment=ha,
+            alpha=src.get_alpha(),
+            verticalalignment=src.get_verticalalignment(),
+            horizontalalignment=src.get_horizontalalignment(),
             rotation=src.get_rotation(),
+            rotation_mode=src.get_rotation_mode(),
             transform=trans,
             clip_on=False,
         )
