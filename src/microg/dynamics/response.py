@@ -834,6 +834,8 @@ def _accel_sub(
 _SUBDIVIDE = 16
 #: new evaluation times per vectorised batch in the refinement (bounds the scratch memory)
 _PEAK_BATCH = 8192
+#: consecutive sample intervals sharing one derivative bound (taken at the first one's start)
+_BOUND_BLOCK = 32
 
 
 @dataclass(frozen=True)
@@ -955,29 +957,29 @@ def combined_modal_force(
 
 
 def _derivative_bounds(
-    st: _State, proj: np.ndarray, t_hi: float
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Bounds of |a|, |a'|, |a''| of every projected row on every segment, each (R, K).
+    st: _State, proj: np.ndarray, seg: np.ndarray, tau: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Bounds of |a'| and |a''| of every projected row from ``tau`` on in segment ``seg``, (R, n).
 
-    Within a segment every modal acceleration obeys the free equation a'' + 2 sigma a' +
-    omega^2 a = 0 (the force is linear there), whose energy E = a'^2 + omega^2 a^2 does not
-    increase (dE/dt = -4 sigma a'^2).  Hence on the segment |a'| <= sqrt(E_k), |a| <=
-    min(sqrt(E_k)/omega, |a_k| + sqrt(E_k) tau_max) and |a''| <= 2 sigma |a'| + omega^2 |a|,
-    with E_k from the state at the segment start (rigid modes: a = p + s tau, the same formulas
-    with omega = 0).  A row's bound is the sum over modes of |T phi| times the modal bound.
+    Within a segment every elastic modal acceleration is a free damped sinusoid
+    ``a = Re(X exp(lambda tau))`` (:func:`_accel_coefficients`; |lambda| = omega), so from
+    elapsed time ``tau`` to the segment's end ``|a'| <= omega A`` and ``|a''| <= omega^2 A`` with
+    the amplitude ``A = |X| exp(-sigma tau)``, which does not increase.  A rigid mode's
+    acceleration is the line ``a_k + j_k tau``: ``|a'| = |j_k|``, ``a'' = 0``.  A row's bound is the
+    sum over modes of ``|T phi|`` times the modal bound.
     """
-    w = st.omega[:, None]
-    sig = (st.zeta * st.omega)[:, None]
-    sqrt_e = np.hypot(st.jerk, w * st.acc)  # (m, K)
-    seg_end = np.r_[st.starts[1:], np.inf]
-    tau_max = np.maximum(np.minimum(seg_end, t_hi) - st.starts, 0.0)[None, :]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        by_energy = np.where(w > 0, sqrt_e / w, np.inf)
-    b0 = np.minimum(by_energy, np.abs(st.acc) + sqrt_e * tau_max)
-    b1 = sqrt_e
-    b2 = 2.0 * sig * b1 + w * w * b0
+    el, rigid = st.elastic, st.rigid
     ap = np.abs(proj)
-    return ap @ b0, ap @ b1, ap @ b2
+    w = st.omega[el]
+    sig = (st.zeta * st.omega)[el][:, None]
+    wd = (w * np.sqrt(1.0 - st.zeta[el] ** 2))[:, None]
+    acc, jerk = st.acc[el][:, seg], st.jerk[el][:, seg]
+    amp = np.hypot(acc, (sig * acc + jerk) / wd) * _exp_decayed(-sig * tau[None, :])
+    b1 = (ap[:, el] * w) @ amp
+    b2 = (ap[:, el] * (w * w)) @ amp
+    if rigid.size:
+        b1 += ap[:, rigid] @ np.abs(st.jerk[rigid][:, seg])
+    return b1, b2
 
 
 def peak_response(
@@ -998,10 +1000,15 @@ def peak_response(
     window with both one-sided limits at a jump (the limit from the left is the end of the
     previous segment), then refined between samples: within a force segment each modal
     acceleration is a damped sinusoid (rigid: a line), and :func:`_derivative_bounds` bounds the
-    second derivative ``M2`` of each axis (and of |a|^2) on the segment.  An interval of length
-    ``h`` whose end values are ``f_a, f_b`` cannot exceed ``max(f_a, f_b) + M2 h^2 / 8`` (Taylor
-    about an interior stationary point); intervals that might exceed the best value found are cut
-    into 16 and evaluated again, until none might exceed it by more than ``rtol``.
+    first and second derivatives ``M1, M2`` of each axis from the start of every block of
+    :data:`_BOUND_BLOCK` intervals on (the modal amplitudes only decay).  An interval of length
+    ``h`` whose end values are ``f_a, f_b`` cannot exceed ``max(f_a, f_b) + M2 h^2 / 8`` (the
+    linear interpolant's error); |a|^2 is bounded by the sum of its axes' bounds squared, and
+    on the intervals that leaves open by the same rule with ``|(|a|^2)''| <= 2 sum (M1^2 + |f|
+    M2)``, ``M1`` tightened to ``|f_b - f_a| / h + M2 h``.  One vectorised pass over all intervals
+    with these bounds leaves only those that might exceed the best sample; they are cut into
+    :data:`_SUBDIVIDE` and evaluated exactly again, until none might exceed the best value by
+    more than ``rtol``.
 
     Guarantee: the true supremum over the window [timepts_out[0], timepts_out[-1]] lies in
     ``[peak, upper_bound]``, and ``upper_bound <= peak (1 + rtol)`` unless ``max_rounds`` ran out
@@ -1040,7 +1047,6 @@ def peak_response(
     n_pts = len(names)
     t_lo, t_hi = float(t[0]), float(t[-1])
     starts = st.starts
-    K = starts.size
 
     def accel(seg: np.ndarray, tt: np.ndarray) -> np.ndarray:
         """Projected acceleration (R, n) at times tt evaluated on segments seg (-1: zero)."""
@@ -1089,45 +1095,78 @@ def peak_response(
         np.concatenate([k_right, seg_left]), np.concatenate([starts[k_right], starts[k_left]])
     )
     vals = np.concatenate([grid_vals, extra], axis=1)
-    order = np.lexsort((side, times))
-    times, segs, side, vals = times[order], segs[order], side[order], vals[:, order]
-
-    b0, b1, b2 = _derivative_bounds(st, proj, t_hi)  # (R, K)
-    bF = 2.0 * (b1 * b1 + b0 * b2).reshape(n_pts, 3, K).sum(axis=1)  # bound of |(|a|^2)''|
-    b2 = np.where(np.isfinite(b2), b2, np.inf)
 
     def mag2(v: np.ndarray) -> np.ndarray:
         return (v * v).reshape(n_pts, 3, *v.shape[1:]).sum(axis=1)
 
+    F = np.concatenate([mag2(grid_vals), mag2(extra)], axis=1)  # |a|^2 (P, samples)
+    sampled = np.sqrt(F[:, : t.size].max(axis=1, initial=0.0))
+    order = np.lexsort((side, times))
+    if np.any(order != np.arange(order.size)):
+        times, segs, side, vals, F = (
+            times[order],
+            segs[order],
+            side[order],
+            vals[:, order],
+            F[:, order],
+        )
     absv = np.abs(vals)
-    best_ax = absv.max(axis=1, initial=0.0)  # (R,)
+    rows = np.arange(proj.shape[0])
     arg_ax = absv.argmax(axis=1) if times.size else np.zeros(proj.shape[0], int)
+    best_ax = absv[rows, arg_ax] if times.size else np.zeros(proj.shape[0])  # (R,)
     t_ax, side_ax = times[arg_ax], side[arg_ax]
-    F = mag2(vals)
-    best_F = F.max(axis=1, initial=0.0)
     arg_F = F.argmax(axis=1)
+    best_F = F[np.arange(n_pts), arg_F]  # (P,)
     t_F, side_F = times[arg_F], side[arg_F]
-    sampled = np.sqrt(mag2(grid_vals).max(axis=1, initial=0.0))
 
     # 2. intervals inside one segment (a jump separates its two limits: no interval across it)
     link = np.flatnonzero((segs[1:] == segs[:-1]) & (segs[:-1] >= 0) & (np.diff(times) > 0))
     ta, tb_, sg = times[link], times[link + 1], segs[link]
-    va, vb = vals[:, link], vals[:, link + 1]
-    rounds = 0
+    # derivative bounds from the start of blocks of up to _BOUND_BLOCK consecutive intervals
+    # of one segment (the bounds only decay within a segment: the block's first start holds)
+    n_int = link.size
+    new_blk = np.ones(n_int, dtype=bool)
+    new_blk[1:] = (sg[1:] != sg[:-1]) | (np.arange(1, n_int) % _BOUND_BLOCK == 0)
+    blk = np.cumsum(new_blk) - 1
+    first = np.flatnonzero(new_blk)
+    d1_blk, d2_blk = _derivative_bounds(st, proj, sg[first], ta[first] - starts[sg[first]])
+    # first pass over all intervals, the cheap bounds: f <= max(|f_a|, |f_b|) + M2 h^2 / 8 per
+    # axis and |a|^2 <= the sum of its axes' bounds squared; the finer bound of |a|^2
+    # (``bounds``) only on the intervals these do not settle
+    h = tb_ - ta
+    u_ax = np.maximum(absv[:, link], absv[:, link + 1])
+    u_ax += d2_blk[:, blk] * (h * h / 8.0)
+    m2 = mag2(u_ax)
     grow = 1.0 + rtol
+    cand = np.any(u_ax > best_ax[:, None] * grow, axis=0) | np.any(
+        m2 > best_F[:, None] * grow * grow, axis=0
+    )
+    # largest bound of every interval set aside: the certified bound of the supremum
+    drop_ax = np.max(u_ax * ~cand, axis=1, initial=0.0)
+    drop_F = np.max(m2 * ~cand, axis=1, initial=0.0)
+    cand_i = np.flatnonzero(cand)
+    ta, tb_, sg, li = ta[cand_i], tb_[cand_i], sg[cand_i], link[cand_i]
+    va, vb = vals[:, li], vals[:, li + 1]
+    d1, d2 = d1_blk[:, blk[cand_i]], d2_blk[:, blk[cand_i]]  # (R, n): bounds of |a'|, |a''|
+    rounds = 0
 
     def bounds(
-        ta: np.ndarray, tb_: np.ndarray, sg: np.ndarray, va: np.ndarray, vb: np.ndarray
+        h: np.ndarray, va: np.ndarray, vb: np.ndarray, d1: np.ndarray, d2: np.ndarray
     ) -> tuple[np.ndarray, np.ndarray]:
-        h2 = (tb_ - ta) ** 2 / 8.0
-        u_ax = np.maximum(np.abs(va), np.abs(vb)) + b2[:, sg] * h2
-        u_F = np.maximum(mag2(va), mag2(vb)) + bF[:, sg] * h2
+        """Upper bounds of |a_axis| (R, n) and |a|^2 (P, n) on intervals of lengths h.
+
+        With |f''| <= M2 on an interval of length h, f <= max(f_a, f_b) + M2 h^2 / 8 (the
+        linear interpolant's error); |f'| <= |f_b - f_a| / h + M2 h (mean value theorem).  For
+        F = |a|^2: F'' = 2 sum (f'^2 + f f''), or directly F <= sum of the axes' bounds squared.
+        """
+        h2 = h * h / 8.0
+        u_ax = np.maximum(np.abs(va), np.abs(vb)) + d2 * h2
+        b1 = np.minimum(d1, np.abs(vb - va) / h + d2 * h)
+        bF = 2.0 * mag2(b1) + 2.0 * (u_ax * d2).reshape(n_pts, 3, -1).sum(axis=1)
+        u_F = np.minimum(np.maximum(mag2(va), mag2(vb)) + bF * h2, mag2(u_ax))
         return u_ax, u_F
 
-    u_ax, u_F = bounds(ta, tb_, sg, va, vb)
-    # largest bound of every interval set aside: the certified bound of the supremum
-    drop_ax = np.zeros(proj.shape[0])
-    drop_F = np.zeros(n_pts)
+    u_ax, u_F = bounds(tb_ - ta, va, vb, d1, d2)
     while True:
         active = np.any(u_ax > best_ax[:, None] * grow, axis=0) | np.any(
             u_F > best_F[:, None] * grow * grow, axis=0
@@ -1137,6 +1176,7 @@ def peak_response(
         drop_F = np.maximum(drop_F, u_F[:, gone].max(axis=1, initial=0.0))
         keep = np.flatnonzero(active)
         ta, tb_, sg, va, vb = ta[keep], tb_[keep], sg[keep], va[:, keep], vb[:, keep]
+        d1, d2 = d1[:, keep], d2[:, keep]
         u_ax, u_F = u_ax[:, keep], u_F[:, keep]
         if keep.size == 0 or rounds >= max_rounds:
             break
@@ -1161,9 +1201,10 @@ def peak_response(
         ta = pts_t[:, :-1].ravel()
         tb_ = pts_t[:, 1:].ravel()
         sg = np.repeat(sg, _SUBDIVIDE)
+        d1, d2 = np.repeat(d1, _SUBDIVIDE, axis=1), np.repeat(d2, _SUBDIVIDE, axis=1)
         va = pts_v[:, :, :-1].reshape(proj.shape[0], -1)
         vb = pts_v[:, :, 1:].reshape(proj.shape[0], -1)
-        u_ax, u_F = bounds(ta, tb_, sg, va, vb)
+        u_ax, u_F = bounds(tb_ - ta, va, vb, d1, d2)
 
     up_ax = np.maximum(np.maximum(best_ax, drop_ax), u_ax.max(axis=1, initial=0.0))
     up_F = np.maximum(np.maximum(best_F, drop_F), u_F.max(axis=1, initial=0.0))
