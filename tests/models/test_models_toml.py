@@ -750,7 +750,9 @@ def stations(draw) -> Station:
     helper = np.eye(3)[int(np.argmin(np.abs(direction)))]
     orientation = helper - helper @ direction * direction
     orientation /= np.linalg.norm(orientation)
-    length = draw(_pos)
+    # the keel's far end and the boom's tip stay inside the 100-km coordinate limit:
+    # |root| <= 1.8 km, plus the keel (<= 60 km), plus the boom (half the keel) <= 92 km
+    length = draw(st.floats(2e-3, 6e4, allow_nan=False))
 
     def inertia():
         a = draw(st.lists(st.floats(-10, 10), min_size=9, max_size=9).map(np.array))
