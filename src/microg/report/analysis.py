@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import gc
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from functools import lru_cache, partial
 from typing import TYPE_CHECKING, Any
 
@@ -158,13 +160,32 @@ def figures(result: Analysis, renderer: FigureRenderer | None = None) -> dict[st
     renderer : FigureRenderer, optional
         Helper processes started before the computation (see :mod:`microg.report.render`):
         they draw the figures while this process loads the HTML template.  Without one, or
-        if it fails, the figures are drawn here.  The bytes are the same either way.
+        if it fails, the figures are drawn here (the default, and the fastest on two
+        cores), with the cyclic garbage collector paused.  The bytes are the same either way.
     """
     if renderer is not None and renderer.active:
         out = renderer.render(figure_jobs, result, while_waiting=_analysis_template)
         if out is not None:
             return out
-    return {j.name: j.draw() for j in figure_jobs(result)}
+    with _collector_paused():
+        return {j.name: j.draw() for j in figure_jobs(result)}
+
+
+@contextmanager
+def _collector_paused() -> Iterator[None]:
+    """Python's cyclic garbage collector off for the block, back as it was after it.
+
+    Importing matplotlib and drawing a figure make many objects, which start collections
+    of the whole heap (~0.1 s of the ~0.5 s the report's figures take); the few figures'
+    reference cycles are collected once, after the block.
+    """
+    was = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if was:
+            gc.enable()
 
 
 #: what a renderer for :func:`figures` preloads
