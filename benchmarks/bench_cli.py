@@ -199,7 +199,6 @@ def _profile_child(out_dir: str, per_figure: bool, helpers: bool) -> dict[str, A
 
     t0, c0 = time.perf_counter(), time.process_time()
     mods0 = set(sys.modules)
-    import tqdm  # noqa: F401  (the command imports it before it computes)
 
     import microg
     import microg.cli
