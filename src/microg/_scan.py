@@ -28,7 +28,7 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["affine_scan", "lti_scan", "SEQUENTIAL_BELOW"]
+__all__ = ["affine_scan", "lti_scan", "scalar_scan", "SEQUENTIAL_BELOW"]
 
 #: chains of at most this many maps are one sequential loop (vectorised over the batch axes)
 SEQUENTIAL_BELOW = 64
@@ -240,3 +240,121 @@ def lti_scan(
         end = PL @ s[-1] + e[-1]
         Y[head:] = lti_scan(Phi, G, u[head:], C, x0=end)
     return Y
+
+
+#: blocks of :func:`scalar_scan` span at most this decay (or growth) of ``|prod a|``, e-folds,
+#: so that the reciprocal products stay far from overflow (e^200 ~ 1e87)
+SCALAR_SPAN = 200.0
+#: :func:`scalar_scan` declines (returns None) when its blocks would be shorter than this
+SCALAR_BLOCK_AT_LEAST = 16
+
+
+def scalar_scan(
+    a: NDArray[np.complexfloating] | NDArray[np.float64],
+    b: NDArray[np.complexfloating] | NDArray[np.float64],
+    *,
+    index: NDArray[np.intp] | None = None,
+    x0: NDArray[np.complexfloating] | None = None,
+    weights: NDArray[np.complexfloating] | None = None,
+    overwrite_b: bool = False,
+    block: int | None = None,
+) -> NDArray[np.complex128] | NDArray[np.float64] | None:
+    """All states of scalar recurrences ``z_{k+1} = a_k z_k + b_k`` (one per row), in O(K).
+
+    The diagonal form of a linear time-invariant step (each eigen-coordinate of the state on
+    its own), evaluated with no loop over samples: the K steps are cut into blocks of ``L``;
+    inside a block, with ``P_r = a_0 ... a_r`` and ``Q_r = (1/a_0) ... (1/a_r)`` (running
+    products of the block's steps), ``z_{r+1} = P_r (z_0 + sum_{j<=r} Q_j b_j)`` (one
+    ``cumprod`` and one ``cumsum``); the block start states follow from the blocks' end products
+    by a loop over the ``K / L`` blocks.  The rounding of ``Q_j b_j`` in the running sum is
+    ``eps |b_j| |P_r / P_j|`` at step r, the sequential loop's own bound: the same accuracy.
+    Blocks span at most :data:`SCALAR_SPAN` e-folds of ``|a|`` so that ``Q`` cannot overflow;
+    when that would make them shorter than :data:`SCALAR_BLOCK_AT_LEAST` steps (a coordinate
+    that decays by more than ~e^12 in one step) the function returns None: the caller takes
+    another method.
+
+    Parameters
+    ----------
+    a : ndarray, shape (m, U)
+        Step factors (dimensionless), the ``U`` distinct steps of each row.
+    b : ndarray, shape (m, K)
+        Offsets, in the units of the state.
+    index : ndarray of int, shape (K,), optional
+        Distinct step of every step (``a[:, index[k]]``); omitted: ``U`` must be 1 (every step
+        the same) or K.
+    x0 : ndarray, shape (m,), optional
+        Start states (zero when omitted).
+    weights : ndarray, shape (q, m), optional
+        Return only the real outputs ``Re(weights @ Z)`` instead of the states.
+    overwrite_b : bool
+        ``b`` (complex) may be used as workspace (saves a copy of the size of ``b``).
+    block : int, optional
+        Block length (tuning only).
+
+    Returns
+    -------
+    ndarray or None
+        States ``Z`` (m, K + 1), complex: ``Z[:, 0] = x0`` and ``Z[:, k + 1] = a_k Z[:, k] +
+        b_k``; with ``weights`` the outputs (q, K + 1), real.  None where declined (above).
+    """
+    a = np.asarray(a, dtype=complex)
+    b = np.asarray(b, dtype=complex)
+    m, K = b.shape
+    U = a.shape[1]
+    if index is None and U not in (1, K):
+        raise ValueError(f"a has {U} steps for {K} offsets and no index")
+    start = np.zeros(m, complex) if x0 is None else np.asarray(x0, complex)
+    if weights is None:
+        Z = np.empty((m, K + 1), dtype=complex)
+        Z[:, 0] = start
+    else:
+        w = np.asarray(weights, complex)
+        Y = np.zeros((w.shape[0], K + 1))
+        Y[:, 0] = (w @ start).real
+    if K == 0:
+        return Z if weights is None else Y
+    with np.errstate(divide="ignore"):
+        decay = float(np.max(np.abs(np.log(np.abs(a))), initial=0.0))
+    if not np.isfinite(decay):
+        return None
+    L = block or max(SEQUENTIAL_BELOW, math.isqrt(2 * K))
+    if decay * L > SCALAR_SPAN:
+        L = int(SCALAR_SPAN / decay)
+        if L < SCALAR_BLOCK_AT_LEAST and K > L:
+            return None
+    L = max(1, min(L, K))
+    B, tail = divmod(K, L)
+    for i in range(m):
+        s = complex(start[i])
+        # the whole blocks, then the last partial block alone (no padded copies)
+        for k0, nb, nl in ((0, B, L), (B * L, 1 if tail else 0, tail)):
+            if not nb:
+                continue
+            k1 = k0 + nb * nl
+            if index is None and U == 1:  # every step the same: the products once, shared
+                P = np.cumprod(np.full(nl, a[i, 0]))
+                Q = np.cumprod(np.full(nl, 1.0 / a[i, 0]))
+            else:
+                ai = a[i, k0:k1] if index is None else a[i, index[k0:k1]]
+                qi = 1.0 / ai if index is None else (1.0 / a[i])[index[k0:k1]]
+                P = np.cumprod(ai.reshape(nb, nl), axis=1)
+                Q = np.cumprod(qi.reshape(nb, nl), axis=1)
+            bi = b[i, k0:k1].reshape(nb, nl)
+            into = Q if Q.ndim == 2 else (bi if overwrite_b and b.dtype == complex else None)
+            loc = np.multiply(bi, Q, out=into)
+            np.cumsum(loc, axis=1, out=loc)
+            # block start states: s_{j+1} = P_end(j) (s_j + S_end(j)), a loop over the blocks
+            p_end = np.broadcast_to(P, (nb, nl))[:, -1].tolist()
+            s_end = loc[:, -1].tolist()
+            starts = [s]
+            for j in range(nb - 1):
+                starts.append(p_end[j] * (starts[j] + s_end[j]))
+            s = p_end[-1] * (starts[-1] + s_end[-1])
+            loc += np.array(starts)[:, None]
+            if weights is None:
+                loc *= P
+                Z[i, k0 + 1 : k1 + 1] = loc.reshape(-1)
+            else:  # Re(w P S) for every output: one complex product each
+                for q in range(w.shape[0]):
+                    Y[q, k0 + 1 : k1 + 1] += np.multiply(loc, w[q, i] * P).real.reshape(-1)
+    return Z if weights is None else Y

@@ -1,8 +1,10 @@
 """The FOH package response's fast paths (issue 10 section 6) against independent references.
 
-``package_response`` takes the shared-map O(N) scan on a uniform grid, and on a grid whose steps
-are whole multiples of one fine step (it refines the grid and picks the samples), otherwise the
-general scan.  References: a closed form (undamped mount, ramp input), solve_ivp (DOP853) step by
+``package_response`` takes the diagonal (eigen-coordinate) recurrence on any grid when the state
+matrix diagonalises well; otherwise the shared-map O(N) scan on a uniform grid, and on a grid whose
+steps are whole multiples of one fine step (it refines the grid and picks the samples), otherwise
+the general scan.  Every test runs twice: on the diagonal path and with it switched off (the
+matrix scans).  References: a closed form (undamped mount, ramp input), solve_ivp (DOP853) step by
 step, and the general scan of :func:`microg._scan.affine_scan` itself.
 """
 
@@ -17,6 +19,12 @@ from microg.isolation.timedomain import IsolatorModel, package_response, state_s
 
 WITH_ABSORBER = IsolatorModel.from_dimensionless(450.0, 135.0, k=10.0, mu=0.05, zeta=0.2)
 BARE = IsolatorModel(m1=450.0, k1=135.0)
+
+
+@pytest.fixture(autouse=True, params=[True, False], ids=["diagonal", "scans"])
+def _path(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Every test on the diagonal path and on the matrix scans."""
+    monkeypatch.setattr(td, "_DIAGONAL", request.param)
 
 
 def _commensurate_grid(n: int, base_s: float, seed: int) -> np.ndarray:
@@ -87,6 +95,7 @@ def test_refined_path_equals_general_scan(monkeypatch: pytest.MonkeyPatch) -> No
     a = np.sin(1.02 * t) + 0.1 * np.sin(17.0 * t)
     fast = package_response(WITH_ABSORBER, t, a)
     monkeypatch.setattr(td, "_REFINE_AT_MOST", 0)  # refinement refused: the general scan
+    monkeypatch.setattr(td, "_DIAGONAL", False)
     general = package_response(WITH_ABSORBER, t, a)
     for key in ("package_accel", "stroke"):
         ref = getattr(general, key)
@@ -138,6 +147,7 @@ def test_piecewise_uniform_grid_equals_general_scan(monkeypatch: pytest.MonkeyPa
     a = np.sin(1.02 * t) + 0.1 * np.sin(17.0 * t)
     fast = package_response(WITH_ABSORBER, t, a)
     monkeypatch.setattr(td, "_RUN_AT_LEAST", 10**9)  # no runs: one general scan
+    monkeypatch.setattr(td, "_DIAGONAL", False)
     general = package_response(WITH_ABSORBER, t, a)
     for key in ("package_accel", "stroke"):
         ref = getattr(general, key)

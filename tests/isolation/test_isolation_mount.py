@@ -105,3 +105,76 @@ def test_screen_margins_equal_each_candidates_own_band_rms() -> None:
             with np.errstate(divide="ignore"):  # bands holding only the (excluded) mean
                 ref = np.min(np.where(rms_g > 0, req.limit_g[keep] / rms_g, np.inf))
             assert got[iz, ik] == pytest.approx(ref, rel=1e-12)
+
+
+@pytest.mark.parametrize("octave", [False, True], ids=["third-octave", "octave"])
+def test_band_power_series_equals_the_sum_over_bins(octave: bool) -> None:
+    # reference: sum_f W psd |T|^2 bin by bin (band_weights, the closed-form |T|^2) for mounts
+    # resonating below, inside and above the bands, damped and not: the Taylor-series bands and
+    # the bin-by-bin ones must both agree with it to rounding (1e-13: the series' tail is bounded
+    # below 1.4e-17 of the band's power, the rest is the sum's own rounding)
+    from microg.environment.metrics import band_weights
+    from microg.environment.requirements import BandTable
+    from microg.isolation.mount import _band_power
+
+    rng = np.random.default_rng(11)
+    df = 0.005
+    f = np.arange(0, 10001) * df
+    psd = rng.random((3, f.size)) * 1e-10
+    ratio = 2.0 if octave else 2 ** (1 / 3)
+    centre = 0.01 * ratio ** np.arange(40)
+    centre = centre[centre < 50.0]
+    bands = BandTable(centre, centre / np.sqrt(ratio), centre * np.sqrt(ratio))
+    W = band_weights(f, df, f[-1], bands)
+    mass = 450.0
+    k_grid = mass * (2 * np.pi * np.geomspace(0.005, 40.0, 61)) ** 2
+    zetas = np.array([0.0, 0.02, 0.3, 1.0, 2.5])
+    k = np.broadcast_to(k_grid, (zetas.size, k_grid.size)).ravel()
+    c = (2 * zetas[:, None] * np.sqrt(k_grid * mass)).ravel()
+    w2 = (2 * np.pi * f) ** 2
+    got, unbounded = _band_power(W, psd, w2, mass, k, c)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t2 = (k[:, None] ** 2 + (c[:, None] ** 2) * w2) / (
+            (k[:, None] - mass * w2) ** 2 + (c[:, None] ** 2) * w2
+        )
+    # unbounded: |T|^2 not finite at some bin with power (the 0.005-Hz mount sits on bin 1, and
+    # a few other undamped ones land exactly on a bin)
+    np.testing.assert_array_equal(unbounded, ~np.all(np.isfinite(t2), axis=1))
+    assert unbounded[0] and not unbounded[k_grid.size :].any()  # damped: never
+    t2 = np.where(np.isfinite(t2), t2, 0.0)
+    ref = np.stack([np.asarray(W.multiply(p[None, :]).tocsr() @ t2.T) for p in psd])
+    np.testing.assert_allclose(got, ref, rtol=1e-13, atol=0)
+
+
+def test_search_mount_choice_equals_the_candidate_loop() -> None:
+    # reference: the rule written as a loop over the screened candidates (stiffest compliant,
+    # else the largest margin; the first of equal candidates wins) on the same margins
+    from microg.environment.metrics import Spectrum
+    from microg.environment.requirements import iss_requirement
+    from microg.isolation.mount import screen_margins, search_mount
+
+    rng = np.random.default_rng(12)
+    df = 0.01
+    f = np.arange(0, 5001) * df
+    req = iss_requirement()
+    mass, zetas = 450.0, (0.0, 0.1, 0.7)
+    for scale in (1e-16, 1e-12, 1e-8):  # every candidate complies, some do, none does
+        psd = rng.random((3, f.size)) * scale
+        spec = Spectrum(f, psd, df, f[-1], "periodogram")
+        k_max = mass * (2 * np.pi * 2.0) ** 2
+        margins = screen_margins(spec, req, mass, k_max, zetas, 3.0, 9)
+        best = None
+        for iz, z in enumerate(zetas):
+            for ik, k1 in enumerate(k_max * np.logspace(-3.0, 0.0, 9)):
+                mg = float(margins[iz, ik])
+                cand = (mg >= 1.0, k1 if mg >= 1.0 else mg, k1, z, mg)
+                if best is None or cand[:2] > best[:2]:
+                    best = cand
+        assert best is not None
+        got = search_mount(spec, req, mass, k_max, zetas=zetas, decades=3.0, n_k=9)
+        assert (got.found, got.k1, got.zeta1, got.min_margin) == (
+            best[0],
+            best[2],
+            best[3],
+            best[4],
+        )

@@ -250,7 +250,7 @@ def advise_isolation(
     from microg.environment.metrics import assess
     from microg.isolation.design import design_mount
     from microg.isolation.mount import search_mount
-    from microg.isolation.timedomain import IsolatorModel, package_response
+    from microg.isolation.timedomain import IsolatorModel, package_responses
 
     if assessment.complies:
         return IsolationAdvice(point, "not-needed", note="complies without isolation")
@@ -306,7 +306,7 @@ def advise_isolation(
             c=design.c or 0.0,
         )
         verified = "report-rule"
-    runs = [package_response(mount, response.timepts, row) for row in response.acceleration]
+    runs = package_responses(mount, response.timepts, response.acceleration)
     pkg = np.array([r.package_accel for r in runs])
     isolated = assess(response.timepts, pkg, requirement)
     stroke = float(max(r.peak_stroke for r in runs))

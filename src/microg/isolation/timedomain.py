@@ -40,7 +40,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import linalg
 
-from microg._scan import affine_scan, lti_scan
+from microg._scan import affine_scan, lti_scan, scalar_scan
 from microg.errors import InputError
 
 __all__ = [
@@ -49,6 +49,7 @@ __all__ = [
     "state_space",
     "foh_discretize",
     "package_response",
+    "package_responses",
 ]
 
 
@@ -360,6 +361,121 @@ def _piecewise_scan(
     return Y[:, 0], Y[:, 1]
 
 
+#: the diagonal path is refused above this condition number of the (balanced) eigenvectors
+_COND_MAX = 1e5
+#: take the diagonal path where it applies (tests switch it off to reach the matrix scans)
+_DIAGONAL = True
+
+
+def _phi12(z: NDArray[np.complex128]) -> tuple[NDArray[np.complex128], NDArray[np.complex128]]:
+    """``phi1(z) = (e^z - 1) / z`` and ``phi2(z) = (e^z - 1 - z) / z^2``, to rounding.
+
+    For ``|z| < 1/2`` their series ``sum z^n / (n+1)!`` and ``sum z^n / (n+2)!`` (24 terms:
+    the rest below ``0.5^24 / 25! ~ 4e-33``); elsewhere the closed forms, whose cancellation
+    costs at most a few roundings there.
+    """
+    small = np.abs(z) < 0.5
+    zs = np.where(small, z, 0.0)
+    p1 = np.zeros_like(z)
+    p2 = np.zeros_like(z)
+    c1 = np.ones_like(z)  # z^n / (n+1)!
+    c2 = np.full_like(z, 0.5)  # z^n / (n+2)!
+    for n in range(24):
+        p1 += c1
+        p2 += c2
+        c1 = c1 * zs / (n + 2)
+        c2 = c2 * zs / (n + 3)
+    zl = np.where(small, 1.0, z)
+    em1 = np.expm1(zl)
+    return np.where(small, p1, em1 / zl), np.where(small, p2, (em1 - zl) / (zl * zl))
+
+
+@dataclass(frozen=True)
+class _Diagonal:
+    """The state space in eigen-coordinates ``x = T V z`` (one of each conjugate pair kept)."""
+
+    lam: NDArray[np.complex128]  # eigenvalues, 1/s
+    bt: NDArray[np.complex128]  # (V^-1 T^-1 B), per coordinate
+    out: NDArray[np.complex128]  # (q, m): output i is Re(out[i] @ z), pairs counted twice
+
+
+def _diagonalize(
+    A: NDArray[np.float64], B: NDArray[np.float64], out_map: NDArray[np.float64]
+) -> _Diagonal | None:
+    """Eigen-coordinates of ``x' = A x + B a0`` (balanced first), or None if ill-conditioned.
+
+    A defective or nearly defective ``A`` (critical damping, coalescing modes) has a large
+    eigenvector condition number; above :data:`_COND_MAX` the rounding it amplifies would
+    exceed the matrix scans', so those take the scans.
+    """
+    Ab, T = linalg.matrix_balance(A, permute=False)
+    lam, V = np.linalg.eig(Ab)
+    if not np.all(np.isfinite(lam)):
+        return None
+    cond = float(np.linalg.cond(V))
+    if not cond <= _COND_MAX:
+        return None
+    t = np.diag(T)
+    bt = np.linalg.solve(V, B[:, 0] / t)
+    out = (out_map * t[None, :]) @ V
+    upper, real = lam.imag > 0, lam.imag == 0
+    if int(upper.sum()) != int((lam.imag < 0).sum()):
+        return None
+    keep = upper | real
+    return _Diagonal(lam[keep], bt[keep], out[:, keep] * np.where(upper[keep], 2.0, 1.0))
+
+
+def _diagonal_outputs(
+    d: _Diagonal,
+    h_unique: NDArray[np.float64],
+    index: NDArray[np.intp] | None,
+    value: NDArray[np.float64],
+    slope: NDArray[np.float64],
+) -> NDArray[np.float64] | None:
+    """Outputs ``(rows, q, K + 1)`` of the FOH recurrence in eigen-coordinates, or None.
+
+    Each coordinate obeys ``z_{k+1} = e^{lam h} z_k + h phi1(lam h) bt a0_k + h^2 phi2(lam h)
+    bt s_k`` (the exact step for a0 linear over the step, ``s_k`` its slope), run by
+    :func:`~microg._scan.scalar_scan` (None where it declines: a coordinate that decays by more
+    than ~e^12 per step).  ``value``, ``slope``: (rows, K).
+    """
+    z = d.lam[:, None] * h_unique[None, :]  # (m, U)
+    p1, p2 = _phi12(z)
+    a = np.exp(z)
+    g1 = h_unique * p1 * d.bt[:, None]
+    g2 = h_unique**2 * p2 * d.bt[:, None]
+    rows, K = value.shape
+    Y = np.zeros((rows, d.out.shape[0], K + 1))
+    b = np.empty(K, complex)
+    bv = b.view(np.float64).reshape(K, 2)
+    tmp = np.empty(K)
+    for i in range(d.lam.size):
+        for r in range(rows):
+            # the offsets g1 a0 + g2 s, real and imaginary parts as contiguous products
+            for part in (0, 1):
+                if index is None:
+                    c1, c2 = (
+                        (g1[i, 0].real, g2[i, 0].real)
+                        if part == 0
+                        else (g1[i, 0].imag, g2[i, 0].imag)
+                    )
+                    np.multiply(value[r], c1, out=bv[:, part])
+                    np.multiply(slope[r], c2, out=tmp)
+                else:
+                    c1v = (g1[i].real if part == 0 else g1[i].imag)[index]
+                    c2v = (g2[i].real if part == 0 else g2[i].imag)[index]
+                    np.multiply(value[r], c1v, out=bv[:, part])
+                    np.multiply(slope[r], c2v, out=tmp)
+                bv[:, part] += tmp
+            out = scalar_scan(
+                a[i : i + 1], b[None], index=index, weights=d.out[:, i : i + 1], overwrite_b=True
+            )
+            if out is None:
+                return None
+            Y[r] += out
+    return Y
+
+
 @dataclass
 class IsolationTimeResponse:
     """Mount and package acceleration histories and their peak/RMS reduction.
@@ -399,6 +515,94 @@ def _ratio(a: float, b: float) -> float:
     return a / b if b > 0 else math.nan
 
 
+def _validated(
+    timepts: ArrayLike, mount_accel: ArrayLike, oversample: int
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Times (N,) and rows of mount acceleration (rows, N), subdivided by ``oversample``."""
+    t = np.asarray(timepts, dtype=float)
+    a0 = np.asarray(mount_accel, dtype=float)
+    if t.ndim != 1 or t.size < 2:
+        raise InputError("need a 1-D array of at least 2 times", where="timepts")
+    if a0.shape[-1:] != t.shape or a0.ndim > 2:
+        raise InputError(f"shape {a0.shape} differs from timepts {t.shape}", where="mount_accel")
+    if not (np.all(np.isfinite(t)) and np.all(np.isfinite(a0))):
+        raise InputError("contains NaN or inf", where="timepts/mount_accel")
+    h = np.diff(t)
+    if not np.all(h > 0):
+        raise InputError("times must be strictly increasing", where="timepts")
+    if not (isinstance(oversample, int | np.integer) and oversample >= 1):
+        raise InputError(f"must be an integer >= 1, got {oversample!r}", where="oversample")
+    a0 = np.atleast_2d(a0)
+    if oversample > 1:
+        frac = np.arange(oversample) / oversample
+        t = np.concatenate(((t[:-1, None] + h[:, None] * frac).ravel(), t[-1:]))
+        lin = (a0[:, :-1, None] + np.diff(a0, axis=1)[:, :, None] * frac).reshape(a0.shape[0], -1)
+        a0 = np.concatenate((lin, a0[:, -1:]), axis=1)
+    return t, a0
+
+
+def _outputs(
+    model: IsolatorModel, t: NDArray[np.float64], a0: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """Package acceleration and stroke ``(rows, 2, N)`` for mount accelerations ``(rows, N)``.
+
+    The diagonal path (:func:`_diagonal_outputs`, every grid) when ``A`` diagonalises well;
+    otherwise the matrix scans of the module docstring.
+    """
+    h = np.diff(t)
+    A, B, C = state_space(model)
+    h_unique, index = _group_steps(h, float(np.max(np.abs(t))), float(t[-1] - t[0]))
+    slope = np.diff(a0, axis=1) / h
+    value = a0[:, :-1]
+    out_map = np.vstack([C, np.eye(A.shape[0])[:1]])  # package acceleration, stroke
+    d = _diagonalize(A, B, out_map) if _DIAGONAL else None
+    if d is not None:
+        Y = _diagonal_outputs(d, h_unique, None if h_unique.size == 1 else index, value, slope)
+        if Y is not None:
+            return Y
+    Phi, G1, G2 = foh_discretize(A, B, h_unique)
+    fine = _commensurate(t, h_unique, index)
+    out = np.empty((a0.shape[0], 2, t.size))
+    for r in range(a0.shape[0]):
+        inputs = np.stack([value[r], slope[r]], axis=1)  # value at the step start, slope
+        if h_unique.size == 1:  # uniform steps: one map, only the two outputs are computed
+            out[r] = lti_scan(Phi[0], np.stack([G1[0], G2[0]]), inputs, out_map).T
+        elif fine is not None:  # every step a whole number of one fine step: uniform fine grid
+            counts, h_fine = fine
+            Phi_f, G1_f, G2_f = foh_discretize(A, B, [h_fine])
+            Y = lti_scan(
+                Phi_f[0], np.stack([G1_f[0], G2_f[0]]), _refine(inputs, counts, h_fine), out_map
+            )
+            out[r] = Y[np.r_[0, np.cumsum(counts)]].T  # fine index of every input sample
+        else:
+            out[r] = np.stack(_piecewise_scan(Phi, G1, G2, index, inputs, out_map))
+    return out
+
+
+def _result(
+    model: IsolatorModel, t: NDArray[np.float64], a0: NDArray[np.float64], Y: NDArray[np.float64]
+) -> IsolationTimeResponse:
+    y, stroke = Y[0], Y[1]
+    peak_mount = float(np.max(np.abs(a0)))
+    peak_package = float(np.max(np.abs(y)))
+    rms_mount = _rms(t, a0)
+    rms_package = _rms(t, y)
+    return IsolationTimeResponse(
+        timepts=t,
+        mount_accel=a0,
+        package_accel=y,
+        stroke=stroke,
+        peak_mount=peak_mount,
+        peak_package=peak_package,
+        rms_mount=rms_mount,
+        rms_package=rms_package,
+        peak_ratio=_ratio(peak_package, peak_mount),
+        rms_ratio=_ratio(rms_package, rms_mount),
+        peak_stroke=float(np.max(np.abs(stroke))),
+        model=model,
+    )
+
+
 def package_response(
     model: IsolatorModel, timepts: ArrayLike, mount_accel: ArrayLike, *, oversample: int = 1
 ) -> IsolationTimeResponse:
@@ -421,60 +625,41 @@ def package_response(
     IsolationTimeResponse
         Start from rest relative to the mount (``u1 - u0 = 0`` and its rate 0 at ``timepts[0]``).
     """
-    t = np.asarray(timepts, dtype=float)
-    a0 = np.asarray(mount_accel, dtype=float)
-    if t.ndim != 1 or t.size < 2:
-        raise InputError("need a 1-D array of at least 2 times", where="timepts")
-    if a0.shape != t.shape:
-        raise InputError(f"shape {a0.shape} differs from timepts {t.shape}", where="mount_accel")
-    if not (np.all(np.isfinite(t)) and np.all(np.isfinite(a0))):
-        raise InputError("contains NaN or inf", where="timepts/mount_accel")
-    h = np.diff(t)
-    if not np.all(h > 0):
-        raise InputError("times must be strictly increasing", where="timepts")
-    if not (isinstance(oversample, int | np.integer) and oversample >= 1):
-        raise InputError(f"must be an integer >= 1, got {oversample!r}", where="oversample")
-    if oversample > 1:
-        frac = np.arange(oversample) / oversample
-        t = np.concatenate(((t[:-1, None] + h[:, None] * frac).ravel(), t[-1:]))
-        a0 = np.concatenate(((a0[:-1, None] + np.diff(a0)[:, None] * frac).ravel(), a0[-1:]))
-        h = np.diff(t)
-    A, B, C = state_space(model)
-    h_unique, index = _group_steps(h, float(np.max(np.abs(t))), float(t[-1] - t[0]))
-    Phi, G1, G2 = foh_discretize(A, B, h_unique)
-    inputs = np.empty((h.size, 2))  # value at the step start and slope over the step
-    inputs[:, 0] = a0[:-1]
-    np.divide(np.diff(a0), h, out=inputs[:, 1])
-    out_map = np.vstack([C, np.eye(A.shape[0])[:1]])  # package acceleration, stroke
-    fine = _commensurate(t, h_unique, index)
-    if h_unique.size == 1:  # uniform steps: one map, only the two outputs are computed
-        Y = lti_scan(Phi[0], np.stack([G1[0], G2[0]]), inputs, out_map)
-        y, stroke = Y[:, 0], Y[:, 1]
-    elif fine is not None:  # every step a whole number of one fine step: uniform fine grid
-        counts, h_fine = fine
-        Phi_f, G1_f, G2_f = foh_discretize(A, B, [h_fine])
-        Y = lti_scan(
-            Phi_f[0], np.stack([G1_f[0], G2_f[0]]), _refine(inputs, counts, h_fine), out_map
+    if np.ndim(mount_accel) != 1:
+        raise InputError(
+            f"shape {np.shape(mount_accel)} is not 1-D",
+            where="mount_accel",
+            fix="give one history, or use package_responses for several",
         )
-        pick = np.r_[0, np.cumsum(counts)]  # fine index of every input sample
-        y, stroke = Y[pick, 0], Y[pick, 1]
-    else:
-        y, stroke = _piecewise_scan(Phi, G1, G2, index, inputs, out_map)
-    peak_mount = float(np.max(np.abs(a0)))
-    peak_package = float(np.max(np.abs(y)))
-    rms_mount = _rms(t, a0)
-    rms_package = _rms(t, y)
-    return IsolationTimeResponse(
-        timepts=t,
-        mount_accel=a0,
-        package_accel=y,
-        stroke=stroke,
-        peak_mount=peak_mount,
-        peak_package=peak_package,
-        rms_mount=rms_mount,
-        rms_package=rms_package,
-        peak_ratio=_ratio(peak_package, peak_mount),
-        rms_ratio=_ratio(rms_package, rms_mount),
-        peak_stroke=float(np.max(np.abs(stroke))),
-        model=model,
-    )
+    t, a0 = _validated(timepts, mount_accel, oversample)
+    return _result(model, t, a0[0], _outputs(model, t, a0)[0])
+
+
+def package_responses(
+    model: IsolatorModel, timepts: ArrayLike, mount_accel: ArrayLike, *, oversample: int = 1
+) -> list[IsolationTimeResponse]:
+    """:func:`package_response` of several mount histories on one time grid (e.g. 3 axes).
+
+    The same results as one call per row; the grid's steps and the model's discretisation are
+    found once and every row runs in the same vectorised pass.
+
+    Parameters
+    ----------
+    model : IsolatorModel
+        Package, mount and optional absorber (kg, N/m, N s/m).
+    timepts : array_like, shape (N,)
+        Strictly increasing sample times, s.
+    mount_accel : array_like, shape (rows, N)
+        Mount accelerations, m/s^2, each taken linear between samples.
+    oversample : int
+        As for :func:`package_response`.
+    """
+    if np.ndim(mount_accel) != 2:
+        raise InputError(
+            f"shape {np.shape(mount_accel)} is not (rows, N)",
+            where="mount_accel",
+            fix="give a 2-D array, one row per history",
+        )
+    t, a0 = _validated(timepts, mount_accel, oversample)
+    Y = _outputs(model, t, a0)
+    return [_result(model, t, a0[r], Y[r]) for r in range(a0.shape[0])]
