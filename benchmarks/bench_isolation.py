@@ -4,22 +4,23 @@
    against a BATCHED numpy solve of the 2x2 complex system of Eq. 4.3 (``numpy.linalg.solve``
    on stacked matrices, chunked over k so the stack fits in memory) -- the best a plain numpy
    user would write; no per-point Python loop.
-2. The exact first-order-hold package response (``package_response``, O(N) blocked scan of
-   :mod:`microg._scan`) on 10^6 samples against a sequential FOH loop compiled with numba (the
-   ``bench`` extra; skipped without it), the same recurrence with the same matrices.  Grids:
-   uniform (the shared-map scan); 3 step lengths 0.5, 1, 2 ms in random order (commensurate:
-   refined onto the uniform 0.5 ms grid, 2.3 x 10^6 fine steps, and the shared-map scan); 3
-   step lengths 0.5, 0.73, 1.1 ms in random order (not commensurate: the general scan, one map
-   per distinct step); 1 ms then 1.37 ms steps (two uniform runs: the shared-map scan on each,
-   the state carried).  On the commensurate grid the loop uses the exact step lengths 0.5, 1,
-   2 ms while
+2. The exact first-order-hold package response (``package_response``) on 10^6 samples against a
+   sequential FOH loop compiled with numba (the ``bench`` extra; skipped without it), the same
+   recurrence with the same matrices.  microg takes the diagonal path on every grid (the
+   4-state model diagonalises well: eigen-coordinates, scalar O(N) recurrences by
+   :func:`microg._scan.scalar_scan`); ``--scans`` times the matrix scans instead (the fallback
+   for a defective A: shared-map scan, refinement, per-run scans).  Grids: uniform; 3 step
+   lengths 0.5, 1, 2 ms in random order (commensurate); 3 step lengths 0.5, 0.73, 1.1 ms in
+   random order (not commensurate); 1 ms then 1.37 ms steps (two uniform runs).  On the
+   commensurate grid the loop uses the exact step lengths 0.5, 1, 2 ms while
    ``t = cumsum(steps)`` has drifted from their multiples by ~1e-8 s of rounding; microg's
-   refined grid keeps every sample within 4e-9 s of its given time, hence the ~4e-10 (of peak)
-   difference between the two, at the rounding of the times, not of the method.
+   grouped steps keep every sample within the rounding of its given time, hence a difference
+   of order 1e-12..1e-10 (of peak) between the two, at the rounding of the times, not of the
+   method.
 
 BLAS is limited to 1 thread for the comparisons.
-Run: ``.venv/bin/python benchmarks/bench_isolation.py [--cpu]`` (about 60 s; ``--cpu`` times this
-thread's CPU time, for a machine whose cores other processes share).
+Run: ``.venv/bin/python benchmarks/bench_isolation.py [--cpu] [--scans]`` (about 60 s; ``--cpu``
+times this thread's CPU time, for a machine whose cores other processes share).
 """
 
 from __future__ import annotations
@@ -186,6 +187,11 @@ def main() -> None:
 if __name__ == "__main__":
     import sys
 
+    if "--scans" in sys.argv[1:]:
+        import microg.isolation.timedomain as td
+
+        td._DIAGONAL = False
+        print("package response: the matrix scans (--scans)")
     if "--cpu" in sys.argv[1:]:
         CLOCK = time.thread_time
         print("timing: this thread's CPU time (--cpu)")

@@ -14,18 +14,26 @@ exact step from ``t_j`` to ``t_j + h`` is read from one matrix exponential of th
     expm(h [[A, B, 0], [0, 0, 1], [0, 0, 0]]) = [[Phi, G1, G2], [0, 1, h], [0, 0, 1]],
     x_{j+1} = Phi x_j + G1 a0_j + G2 (a0_{j+1} - a0_j)/h.
 
-One exponential per distinct step (steps equal to within the rounding of the time points share
-one).  The recursion is the one blocked O(N) scan of :mod:`microg._scan`: on a uniform grid
-(one shared map) :func:`~microg._scan.lti_scan` computes only the two outputs (package
-acceleration and stroke).  A grid whose steps are all whole multiples of one fine step (e.g.
-steps of 0.5, 1 and 2 ms in any order) is refined onto that uniform fine grid, where the input
-is the same piecewise-linear function, and takes the shared-map scan too (at most
-``_REFINE_AT_MOST`` fine steps per step, every sample kept within the rounding of its time, see
-:func:`_commensurate`); the samples are picked from it.  On any other grid each run of at
-least ``_RUN_AT_LEAST`` equal steps takes the shared-map scan, the state carried exactly from
-run to run, and the steps between runs :func:`~microg._scan.affine_scan` (the states, one map
-per distinct step); a grid with fewer long runs is one ``affine_scan``.  Both are vectorised
-over blocks of about sqrt(N) steps, with no loop over samples.
+Steps equal to within the rounding of the time points share one step map.  When ``A``
+diagonalises well (eigenvector condition number, after balancing, at most ``_COND_MAX``), the
+state is taken in eigen-coordinates ``x = T V z``: each coordinate obeys a scalar recurrence
+``z_{j+1} = e^{lam h} z_j + h phi1(lam h) b a0_j + h^2 phi2(lam h) b (a0_{j+1} - a0_j)/h``
+(``phi1(z) = (e^z - 1)/z``, ``phi2(z) = (e^z - 1 - z)/z^2``: the same exact step), one of each
+conjugate pair kept, run in O(N) on any grid by :func:`~microg._scan.scalar_scan` (running
+products and sums in blocks; no loop over samples).  A defective or ill-conditioned ``A``
+(critical damping), or a coordinate that decays by more than ~e^12 in one step, takes the matrix
+scans instead.  These read the maps from one matrix exponential per distinct step and run the
+blocked O(N) scan of :mod:`microg._scan`: on a uniform grid (one shared map)
+:func:`~microg._scan.lti_scan` computes only the two outputs (package acceleration and stroke).
+A grid whose steps are all whole multiples of one fine step (e.g. steps of 0.5, 1 and 2 ms in any
+order) is refined onto that uniform fine grid, where the input is the same piecewise-linear
+function, and takes the shared-map scan too (at most ``_REFINE_AT_MOST`` fine steps per step,
+every sample kept within the rounding of its time, see :func:`_commensurate`); the samples are
+picked from it.  On any other grid each run of at least ``_RUN_AT_LEAST`` equal steps takes the
+shared-map scan, the state carried exactly from run to run, and the steps between runs
+:func:`~microg._scan.affine_scan` (the states, one map per distinct step); a grid with fewer long
+runs is one ``affine_scan``.  Both are vectorised over blocks of about sqrt(N) steps.
+:func:`package_responses` runs several histories on one grid (e.g. three axes) in one call.
 
 Initial condition: the package (and absorber) start at rest relative to the mount, ``z = z' = 0``
 at ``timepts[0]``.
