@@ -22,9 +22,11 @@ state is taken in eigen-coordinates ``x = T V z``: each coordinate obeys a scala
 conjugate pair kept, run in O(N) on any grid by :func:`~microg._scan.scalar_scan` (running
 products and sums in blocks; no loop over samples).  A defective or ill-conditioned ``A``
 (critical damping), or a coordinate that decays by more than ~e^12 in one step, takes the matrix
-scans instead.  These read the maps from one matrix exponential per distinct step and run the
-blocked O(N) scan of :mod:`microg._scan`: on a uniform grid (one shared map)
-:func:`~microg._scan.lti_scan` computes only the two outputs (package acceleration and stroke).
+scans instead, and so does a grid of more than ``_SCANS_ABOVE`` steps made mostly of long
+uniform runs (the shared-map scan is faster there).  These read the maps from one matrix
+exponential per distinct step and run the blocked O(N) scan of :mod:`microg._scan`: on a
+uniform grid (one shared map) :func:`~microg._scan.lti_scan` computes only the two outputs
+(package acceleration and stroke).
 A grid whose steps are all whole multiples of one fine step (e.g. steps of 0.5, 1 and 2 ms in any
 order) is refined onto that uniform fine grid, where the input is the same piecewise-linear
 function, and takes the shared-map scan too (at most ``_REFINE_AT_MOST`` fine steps per step,
@@ -549,6 +551,21 @@ def _validated(
     return t, a0
 
 
+#: above this many steps, a grid made of long uniform runs takes the shared-map scans (measured
+#: faster there on 10^6 steps: BLAS on a few state columns against complex running products)
+_SCANS_ABOVE = 100_000
+
+
+def _runs_favour_scans(index: NDArray[np.intp]) -> bool:
+    """True for a long grid whose runs of ``_RUN_AT_LEAST`` equal steps cover half its steps."""
+    K = index.size
+    if K <= _SCANS_ABOVE:
+        return False
+    bounds = np.r_[0, np.flatnonzero(np.diff(index)) + 1, K]
+    lengths = np.diff(bounds)
+    return 2 * int(lengths[lengths >= _RUN_AT_LEAST].sum()) >= K
+
+
 def _outputs(
     model: IsolatorModel, t: NDArray[np.float64], a0: NDArray[np.float64]
 ) -> NDArray[np.float64]:
@@ -563,7 +580,7 @@ def _outputs(
     slope = np.diff(a0, axis=1) / h
     value = a0[:, :-1]
     out_map = np.vstack([C, np.eye(A.shape[0])[:1]])  # package acceleration, stroke
-    d = _diagonalize(A, B, out_map) if _DIAGONAL else None
+    d = _diagonalize(A, B, out_map) if _DIAGONAL and not _runs_favour_scans(index) else None
     if d is not None:
         Y = _diagonal_outputs(d, h_unique, None if h_unique.size == 1 else index, value, slope)
         if Y is not None:
