@@ -48,6 +48,8 @@ def test_shape_peaks_in_blocks_equal_the_whole_array_maximum():
     # block maxima is the same element (max is exact), so bit for bit
     ref = np.max(np.abs(model.phi[:, :3, :]), axis=(0, 1))
     np.testing.assert_array_equal(smp.shape_peaks(), ref)
+    ref_rot = np.max(np.abs(model.phi[:, 3:6, :]), axis=(0, 1))
+    np.testing.assert_array_equal(smp.shape_peaks("rotation"), ref_rot)
 
 
 def test_modal_mass_from_sample_peaks_equals_the_dense_displacements():

@@ -187,12 +187,20 @@ class ModalSamples:
     def shape_peaks(self, part: str = "translation") -> np.ndarray:
         """Largest |translation| (or |rotation|, rad) of each shape over grids and axes (m,)."""
         if part not in self._peaks:
-            # in blocks of grids: no (g, 3, m) temporary of |phi| (max commutes with blocks)
-            pt = self._part(part)
-            peak = np.zeros(pt.shape[2])
-            for i in range(0, pt.shape[0], _PEAK_BLOCK):
-                np.maximum(peak, np.max(np.abs(pt[i : i + _PEAK_BLOCK]), axis=(0, 1)), out=peak)
-            self._peaks[part] = peak
+            # both parts in one pass over the shapes, in blocks of grids: no (g, 6, m)
+            # temporary of |phi| (max commutes with blocks; max |x| = max(max x, -min x))
+            phi = self._model.phi
+            rows = phi.shape[1]
+            hi = np.full((rows, phi.shape[2]), -np.inf)
+            lo = np.full((rows, phi.shape[2]), np.inf)
+            for i in range(0, phi.shape[0], _PEAK_BLOCK):
+                block = phi[i : i + _PEAK_BLOCK]
+                np.maximum(hi, block.max(axis=0), out=hi)
+                np.minimum(lo, block.min(axis=0), out=lo)
+            per_row = np.maximum(hi, -lo) if phi.shape[0] else np.zeros_like(hi)
+            self._peaks["translation"] = per_row[:3].max(axis=0)
+            rot = per_row[3:6]
+            self._peaks["rotation"] = rot.max(axis=0) if rot.shape[0] else np.zeros(phi.shape[2])
         return self._peaks[part]
 
     def _part(self, part: str) -> np.ndarray:
