@@ -934,12 +934,21 @@ def _modal_acceleration(
     return eta, vel, acc
 
 
-def _modal_accel_at(m: Modes, zeta: np.ndarray, loads: list[_Load], pk: PeakResponse) -> np.ndarray:
-    """Modal accelerations (k,) at the exact peak (the limit from the left at a jump)."""
-    tp = float(pk.peak_time_s)
-    if pk.peak_side == "left":
-        tp = float(np.nextafter(tp, -np.inf))
-    return _modal_acceleration(m, zeta, loads, np.array([tp]))[2][:, 0]
+def _modal_accel_at(
+    m: Modes, zeta: np.ndarray, loads: list[_Load], peaks: Sequence[PeakResponse]
+) -> np.ndarray:
+    """Modal accelerations (k, len(peaks)) at the exact peaks, in one evaluation.
+
+    At a jump on the peak's left side, the limit from the left (the time just before it).
+    """
+    tp = np.array([float(pk.peak_time_s) for pk in peaks])
+    left = np.array([pk.peak_side == "left" for pk in peaks], bool)
+    tp = np.where(left, np.nextafter(tp, -np.inf), tp)
+    order = np.argsort(tp, kind="stable")
+    acc = np.empty((m.n_modes, tp.size))
+    if tp.size:
+        acc[:, order] = _modal_acceleration(m, zeta, loads, tp[order])[2]
+    return acc
 
 
 def _with_exact_peak(a: Assessment, peak: PeakResponse, req: Requirement) -> Assessment:
@@ -1290,42 +1299,45 @@ def _transient(
     eta, vel, acc = _modal_acceleration(m, zeta, loads, t)
     step("assessment")
     peaks = peak_response(m.omega, zeta, m.phi, maps, [(ld.force, ld.b) for ld in loads], t)
-    observations: dict[str, Observation] = {}
     mode_numbers = idx + 1
     modal = _ModalSeries(t, acc)
     # every point's rows in one product per series (one GEMM, not one per point)
     rows = [tmap @ m.phi for tmap in maps.values()]
     tphi_all = np.concatenate(rows) if rows else np.zeros((0, m.n_modes))
     d_all, v_all, a_all = tphi_all @ eta, tphi_all @ vel, tphi_all @ acc
-    for j, name in enumerate(maps):
+    acc_at_peaks = _modal_accel_at(m, zeta, loads, [peaks[name] for name in maps])
+
+    def observe(j: int, name: str) -> Observation:
         r = slice(3 * j, 3 * j + 3)
         tphi = tphi_all[r]
         resp = PointResponse(name, t, d_all[r], v_all[r], a_all[r])
         a = _with_exact_peak(assess(t, resp.acceleration, req), peaks[name], req)
-        contrib = _contributions(
-            mode_numbers, m, tphi, modal, a, _modal_accel_at(m, zeta, loads, peaks[name])
-        )
-        observations[name] = Observation(
+        return Observation(
             name=name,
             response=resp,
             assessment=a,
             isolation=IsolationAdvice.not_assessed(name),
-            contributions=contrib,
+            contributions=_contributions(mode_numbers, m, tphi, modal, a, acc_at_peaks[:, j]),
             interval=_intervals(t, resp.acceleration, req),
             peak=peaks[name],
         )
+
+    def isolate(ob: Observation) -> Observation:
+        adv = advise_isolation(
+            ob.name,
+            ob.assessment,
+            ob.response,
+            req,
+            package_mass=opts.package_mass_kg,
+            absorber_mu=opts.absorber_mu,
+        )
+        return replace(ob, isolation=adv)
+
+    obs = [observe(j, name) for j, name in enumerate(maps)]
     step("isolation")
     if opts.isolation:
-        for name, ob in observations.items():
-            adv = advise_isolation(
-                name,
-                ob.assessment,
-                ob.response,
-                req,
-                package_mass=opts.package_mass_kg,
-                absorber_mu=opts.absorber_mu,
-            )
-            observations[name] = replace(ob, isolation=adv)
+        obs = [isolate(ob) for ob in obs]
+    observations = {ob.name: ob for ob in obs}
     return observations, t, warnings
 
 

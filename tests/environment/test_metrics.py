@@ -549,3 +549,20 @@ def test_band_mean_square_of_a_bin_centred_sine_is_half_its_square():
     bands = BandTable(np.array([f0]), np.array([f0 * 0.9]), np.array([f0 * 1.1]))
     got = band_mean_square(t, x, bands)
     assert got[0, 0] == pytest.approx(amp**2 / 2, rel=1e-12)
+
+
+def test_band_weights_are_kept_read_only_and_equal_a_fresh_computation():
+    """The kept map is the computed one (reference: the uncached kernel) and cannot change."""
+    from microg.environment.metrics import _band_weights, band_weights
+
+    f = np.fft.rfftfreq(2001, 0.01)
+    bands = third_octave_bands(0.1, 40.0)
+    w1 = band_weights(f, f[1], 50.0, bands)
+    w2 = band_weights(f.copy(), f[1], 50.0, bands)
+    assert w2 is w1  # the same inputs: the kept map
+    ref = _band_weights(f, f[1], 50.0, bands.lower_hz, bands.upper_hz)
+    assert (w1 != ref).nnz == 0
+    with pytest.raises(ValueError):
+        w1.data[0] = 1.0
+    other = band_weights(f, f[1], 50.0, third_octave_bands(0.2, 40.0))
+    assert other is not w1 and other.shape[0] < w1.shape[0]

@@ -33,6 +33,7 @@ Definitions (see docs/assessment.md):
 from __future__ import annotations
 
 import math
+import threading
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -847,6 +848,8 @@ def band_weights(freq_hz: np.ndarray, df_hz: float, nyquist_hz: float, bands: Ba
     ``psd_k df``; a band ``[lo, hi]`` (clipped to Nyquist) takes the fraction of each bin it
     overlaps (the PSD constant across a bin), and the 0-Hz bin's power (the mean) is left out.
     ``W[b, k] = df |[lo, hi] ∩ bin_k| / |bin_k|``.  Sparse: each band covers a run of bins.
+    The last few maps are kept (a run judges many series on one grid and band table) and
+    shared, so they are read-only.
 
     Parameters
     ----------
@@ -864,13 +867,38 @@ def band_weights(freq_hz: np.ndarray, df_hz: float, nyquist_hz: float, bands: Ba
     scipy.sparse.csr_matrix (nb, nf)
         Hz.
     """
+    f = np.asarray(freq_hz, float)
+    lo = np.asarray(bands.lower_hz, float)
+    hi = np.asarray(bands.upper_hz, float)
+    key = (f.tobytes(), float(df_hz), float(nyquist_hz), lo.tobytes(), hi.tobytes())
+    w = _BAND_WEIGHTS.get(key)
+    if w is None:
+        w = _band_weights(f, float(df_hz), float(nyquist_hz), lo, hi)
+        for a in (w.data, w.indices, w.indptr):
+            a.flags.writeable = False  # shared between callers: never changed in place
+        with _BAND_WEIGHTS_LOCK:
+            if len(_BAND_WEIGHTS) >= _BAND_WEIGHTS_MAX:
+                _BAND_WEIGHTS.pop(next(iter(_BAND_WEIGHTS)))
+            _BAND_WEIGHTS[key] = w
+    return w
+
+
+#: band_weights' last maps, by their inputs (a run judges many series on one grid and table)
+_BAND_WEIGHTS: dict[tuple[bytes, float, float, bytes, bytes], Any] = {}
+_BAND_WEIGHTS_MAX = 8
+_BAND_WEIGHTS_LOCK = threading.Lock()
+
+
+def _band_weights(
+    f: np.ndarray, df_hz: float, nyquist_hz: float, lower_hz: np.ndarray, upper_hz: np.ndarray
+) -> Any:
+    """:func:`band_weights` computed (no cache)."""
     import scipy.sparse as sp
 
-    f = np.asarray(freq_hz, float)
-    nb = bands.center_hz.size
+    nb = lower_hz.size
     edges = np.r_[0.0, np.minimum(f + df_hz / 2, nyquist_hz)]
-    lo = np.minimum(bands.lower_hz, nyquist_hz)
-    hi = np.minimum(bands.upper_hz, nyquist_hz)
+    lo = np.minimum(lower_hz, nyquist_hz)
+    hi = np.minimum(upper_hz, nyquist_hz)
     # bins j0 <= j < j1 overlap [lo, hi]
     j0 = np.clip(np.searchsorted(edges, lo, side="right") - 1, 0, f.size)
     j1 = np.clip(np.searchsorted(edges, hi, side="left"), 0, f.size)
