@@ -49,7 +49,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -124,6 +124,56 @@ class ModalResponse:
     eta_dot: np.ndarray
     eta_ddot: np.ndarray
 
+    def to_dict(self) -> dict[str, object]:
+        """JSON-ready summary: the record and each mode's largest sampled |value|.
+
+        The histories themselves are in :meth:`to_xarray` (a record of 200 modes x 20,001
+        samples is 32 MB a series, too much for JSON).
+        """
+        t = np.asarray(self.timepts, float)
+        return {
+            "n_modes": int(self.eta.shape[0]),
+            "n_samples": int(t.size),
+            "t_start_s": float(t[0]) if t.size else None,
+            "t_end_s": float(t[-1]) if t.size else None,
+            "peak_eta": _row_peaks(self.eta),
+            "peak_eta_dot": _row_peaks(self.eta_dot),
+            "peak_eta_ddot": _row_peaks(self.eta_ddot),
+        }
+
+    def to_xarray(self) -> Any:
+        """``eta``, ``eta_dot``, ``eta_ddot`` as an ``xarray.Dataset`` over (mode, time).
+
+        Modal units: for mass-normalised modes ``eta`` is m sqrt(kg), its rates per s and
+        per s^2 (attribute ``units``); ``mode`` counts from 1.
+        """
+        import xarray as xr
+
+        dims = ("mode", "time")
+        return xr.Dataset(
+            {
+                "eta": (dims, self.eta, {"units": "m kg^0.5"}),
+                "eta_dot": (dims, self.eta_dot, {"units": "m kg^0.5 / s"}),
+                "eta_ddot": (dims, self.eta_ddot, {"units": "m kg^0.5 / s^2"}),
+            },
+            coords={
+                "mode": ("mode", np.arange(1, self.eta.shape[0] + 1), {"units": "1"}),
+                "time": ("time", np.asarray(self.timepts, float), {"units": "s"}),
+            },
+        )
+
+    def plot(self, n_show: int = 6) -> Any:
+        """The modal accelerations of the ``n_show`` modes with the largest peak (a Figure)."""
+        from microg.plotting.modes import plot_modal_response
+
+        return plot_modal_response(self, n_show=n_show)
+
+
+def _row_peaks(a: np.ndarray) -> list[float]:
+    """Largest |value| of each row (an empty row: 0)."""
+    a = np.atleast_2d(np.asarray(a, float))
+    return np.max(np.abs(a), axis=1, initial=0.0).tolist()
+
 
 @dataclass(frozen=True)
 class PointResponse:
@@ -147,6 +197,52 @@ class PointResponse:
     def acceleration_g(self) -> np.ndarray:
         """Acceleration in units of standard gravity (G0 = 9.80665 m/s^2), shape (3, nt)."""
         return self.acceleration / G0
+
+    def to_dict(self) -> dict[str, object]:
+        """JSON-ready summary: the record and the largest sampled values per axis (SI).
+
+        ``peak_accel_g`` is the largest sampled |a| (vector magnitude); the certified
+        maximum between samples is :class:`PeakResponse`'s.  The histories are in
+        :meth:`to_xarray`.
+        """
+        t = np.asarray(self.timepts, float)
+        mag = np.linalg.norm(np.asarray(self.acceleration, float), axis=0)
+        return {
+            "name": self.name,
+            "n_samples": int(t.size),
+            "t_start_s": float(t[0]) if t.size else None,
+            "t_end_s": float(t[-1]) if t.size else None,
+            "peak_displacement_m_axis": _row_peaks(self.displacement),
+            "peak_velocity_mps_axis": _row_peaks(self.velocity),
+            "peak_accel_mps2_axis": _row_peaks(self.acceleration),
+            "sampled_peak_accel_g": float(np.max(mag, initial=0.0)) / G0,
+        }
+
+    def to_xarray(self) -> Any:
+        """Displacement, velocity and acceleration as an ``xarray.Dataset`` over (axis, time)."""
+        import xarray as xr
+
+        dims = ("axis", "time")
+        return xr.Dataset(
+            {
+                "displacement_m": (dims, self.displacement, {"units": "m"}),
+                "velocity_mps": (dims, self.velocity, {"units": "m/s"}),
+                "accel_mps2": (dims, self.acceleration, {"units": "m/s^2"}),
+            },
+            coords={
+                "axis": ("axis", ["x", "y", "z"][: np.shape(self.acceleration)[0]]),
+                "time": ("time", np.asarray(self.timepts, float), {"units": "s"}),
+            },
+            attrs={"point": self.name},
+        )
+
+    def plot(self) -> Any:
+        """The acceleration history, micro-g against s (a Figure)."""
+        from microg.plotting.environment import plot_time_history
+
+        return plot_time_history(
+            self.timepts, self.acceleration, title=f"Acceleration at {self.name}"
+        )
 
 
 def _sinc(theta: np.ndarray) -> np.ndarray:
@@ -920,6 +1016,32 @@ class PeakResponse:
             "sampled_peak_accel_mps2": self.sampled_peak_accel_mps2,
             "rounds": self.rounds,
         }
+
+    def to_xarray(self) -> Any:
+        """The per-axis peaks, times and bounds as an ``xarray.Dataset`` over ``axis``.
+
+        The magnitude's peak, time, side, bound and sampled peak are attributes.
+        """
+        import xarray as xr
+
+        return xr.Dataset(
+            {
+                "peak_accel_mps2": ("axis", self.peak_accel_mps2_axis, {"units": "m/s^2"}),
+                "peak_time_s": ("axis", self.peak_time_s_axis, {"units": "s"}),
+                "upper_bound_mps2": ("axis", self.upper_bound_mps2_axis, {"units": "m/s^2"}),
+            },
+            coords={"axis": ("axis", ["x", "y", "z"])},
+            attrs={
+                "point": self.name,
+                "window_s": list(self.window_s),
+                "magnitude_peak_accel_mps2": self.peak_accel_mps2,
+                "magnitude_peak_time_s": self.peak_time_s,
+                "magnitude_peak_side": self.peak_side,
+                "magnitude_upper_bound_mps2": self.upper_bound_mps2,
+                "sampled_peak_accel_mps2": self.sampled_peak_accel_mps2,
+                "rounds": self.rounds,
+            },
+        )
 
 
 def _one_sided(force: ForceHistory, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

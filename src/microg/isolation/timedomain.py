@@ -45,6 +45,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -515,6 +516,54 @@ class IsolationTimeResponse:
     rms_ratio: float
     peak_stroke: float
     model: IsolatorModel
+
+    def to_dict(self) -> dict[str, object]:
+        """JSON-ready summary: peaks, RMS, their ratios, the stroke and the isolator (SI)."""
+        from microg.environment.metrics import json_number
+
+        m = self.model
+        t = np.asarray(self.timepts, float)
+        return {
+            "n_samples": int(t.size),
+            "t_start_s": float(t[0]) if t.size else None,
+            "t_end_s": float(t[-1]) if t.size else None,
+            "peak_mount_mps2": self.peak_mount,
+            "peak_package_mps2": self.peak_package,
+            "rms_mount_mps2": self.rms_mount,
+            "rms_package_mps2": self.rms_package,
+            "peak_ratio": json_number(self.peak_ratio),
+            "rms_ratio": json_number(self.rms_ratio),
+            "peak_stroke_m": self.peak_stroke,
+            "isolator": {
+                "m1_kg": m.m1,
+                "k1_N_per_m": m.k1,
+                "c1_N_s_per_m": m.c1,
+                "m2_kg": m.m2,
+                "k2_N_per_m": m.k2,
+                "c_N_s_per_m": m.c,
+                "freq_hz_n": m.omega_n / (2.0 * math.pi),
+            },
+        }
+
+    def to_xarray(self) -> Any:
+        """Mount and package accelerations and the stroke as an ``xarray.Dataset`` over time."""
+        import xarray as xr
+
+        return xr.Dataset(
+            {
+                "mount_accel_mps2": ("time", self.mount_accel, {"units": "m/s^2"}),
+                "package_accel_mps2": ("time", self.package_accel, {"units": "m/s^2"}),
+                "stroke_m": ("time", self.stroke, {"units": "m"}),
+            },
+            coords={"time": ("time", np.asarray(self.timepts, float), {"units": "s"})},
+            attrs={"peak_ratio": self.peak_ratio, "rms_ratio": self.rms_ratio},
+        )
+
+    def plot(self) -> Any:
+        """Mount and package accelerations against time, micro-g (a Figure)."""
+        from microg.plotting.isolation import plot_package_response
+
+        return plot_package_response(self)
 
 
 def _rms(t: NDArray[np.float64], y: NDArray[np.float64]) -> float:

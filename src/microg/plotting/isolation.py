@@ -34,6 +34,7 @@ __all__ = [
     "plot_mount_design",
     "plot_mount_choice",
     "plot_isolation_advice",
+    "plot_package_response",
 ]
 
 
@@ -214,4 +215,37 @@ def plot_isolation_advice(advice: IsolationAdvice) -> Figure:
             label="largest M_a allowed (1 / attenuation needed)",
         )
     _log_axes(ax, "frequency [Hz]", "magnification")
+    return finish(fig)
+
+
+def plot_package_response(response: Any, *, title: str = "") -> Figure:
+    """Mount (support) and isolated-package accelerations against time, in micro-g.
+
+    Parameters
+    ----------
+    response : IsolationTimeResponse
+        ``timepts`` in s, ``mount_accel`` and ``package_accel`` in m/s^2.
+    title : str, optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    from microg.plotting.common import envelope
+    from microg.units import G0
+
+    t = np.asarray(response.timepts, float)
+    fig = new_figure(7.5, 3.8)
+    ax = fig.subplots()
+    ax.plot(*envelope(t, np.asarray(response.mount_accel) / G0 * 1e6), lw=0.8, label="mount")
+    ax.plot(*envelope(t, np.asarray(response.package_accel) / G0 * 1e6), lw=0.8, label="package")
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("acceleration [micro-g]")
+    ax.set_title(
+        title
+        or f"Isolated package: peak ratio {response.peak_ratio:.3g}, "
+        f"RMS ratio {response.rms_ratio:.3g}"
+    )
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8)
     return finish(fig)

@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 from matplotlib.figure import Figure
 
-__all__ = ["plot_modes"]
+__all__ = ["plot_modal_response", "plot_modes"]
 
 
 def plot_modes(modes: Any, *, title: str | None = None) -> Figure:
@@ -51,3 +51,43 @@ def plot_modes(modes: Any, *, title: str | None = None) -> Figure:
     ax.set_title(title or f"{modes.method}: {modes.n_modes} modes, {n_rigid} rigid at 0 Hz")
     ax.grid(True, which="both", alpha=0.3)
     return fig
+
+
+def plot_modal_response(response: Any, *, n_show: int = 6, title: str = "") -> Figure:
+    """Modal accelerations against time: the ``n_show`` modes with the largest peak.
+
+    Parameters
+    ----------
+    response : ModalResponse
+        ``timepts`` in s; ``eta_ddot`` (m, nt) in the modal unit (m/s^2 per unit modal
+        coordinate times sqrt(kg) for mass-normalised modes).
+    n_show : int
+        Modes drawn (the others are listed by count in the title).
+    title : str, optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    from microg.plotting.common import envelope, finish, new_figure
+
+    acc = np.atleast_2d(np.asarray(response.eta_ddot, float))
+    t = np.asarray(response.timepts, float)
+    peak = np.max(np.abs(acc), axis=1) if acc.size else np.zeros(acc.shape[0])
+    order = np.argsort(-peak, kind="stable")[: max(int(n_show), 0)]
+    fig = new_figure(7.5, 4.0)
+    ax = fig.subplots()
+    for j in order:
+        ax.plot(*envelope(t, acc[j]), lw=0.8, label=f"mode {j + 1}")
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("modal acceleration")
+    rest = acc.shape[0] - order.size
+    ax.set_title(
+        title
+        or f"Modal accelerations ({order.size} largest"
+        + (f"; {rest} more not drawn)" if rest > 0 else ")")
+    )
+    ax.grid(True, alpha=0.3)
+    if order.size:
+        ax.legend(fontsize=8)
+    return finish(fig)
