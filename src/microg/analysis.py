@@ -1298,13 +1298,14 @@ def _transient(
     t = np.arange(0.0, opts.duration_s + 0.5 * opts.dt_s, opts.dt_s)
     eta, vel, acc = _modal_acceleration(m, zeta, loads, t)
     step("assessment")
-    peaks = peak_response(m.omega, zeta, m.phi, maps, [(ld.force, ld.b) for ld in loads], t)
     mode_numbers = idx + 1
     modal = _ModalSeries(t, acc)
     # every point's rows in one product per series (one GEMM, not one per point)
     rows = [tmap @ m.phi for tmap in maps.values()]
     tphi_all = np.concatenate(rows) if rows else np.zeros((0, m.n_modes))
     d_all, v_all, a_all = tphi_all @ eta, tphi_all @ vel, tphi_all @ acc
+    loads_b = [(ld.force, ld.b) for ld in loads]
+    peaks = peak_response(m.omega, zeta, m.phi, maps, loads_b, t, grid_accel=a_all)
     acc_at_peaks = _modal_accel_at(m, zeta, loads, [peaks[name] for name in maps])
 
     def observe(j: int, name: str) -> Observation:
