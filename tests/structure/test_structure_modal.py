@@ -152,6 +152,19 @@ def test_samples_are_views_and_products_equal_the_dense_ones(fe):
     np.testing.assert_allclose(
         smp.peak_translation(m2.phi), np.max(np.abs(dense), axis=(0, 1)), rtol=1e-13
     )
+    # rotations likewise, against the dense rotational motion (reference: einsum)
+    rot = np.einsum("gam,mk->gak", model.phi[:, 3:6, :], m2.phi)
+    np.testing.assert_allclose(
+        smp.peak_rotation(m2.phi), np.max(np.abs(rot), axis=(0, 1)), rtol=1e-13
+    )
+    # a general coordinate matrix (every column mixing, rows not consecutive) after it
+    q2 = np.zeros((30, 3))
+    q2[[2, 7, 11], :] = rng.standard_normal((3, 3))
+    np.testing.assert_allclose(
+        smp.peak_rotation(q2),
+        np.max(np.abs(np.einsum("gam,mk->gak", model.phi[:, 3:6, :], q2)), axis=(0, 1)),
+        rtol=1e-13,
+    )
 
 
 def _random_model(g: int, m: int, seed: int = 0):

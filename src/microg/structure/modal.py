@@ -128,6 +128,7 @@ class ModalSamples:
         self._model = model
         self._labels: tuple[str, ...] | None = None
         self._peaks: dict[str, np.ndarray] = {}
+        self._last_q: tuple[np.ndarray, dict[str, np.ndarray]] | None = None
 
     @property
     def position(self) -> np.ndarray:
@@ -227,18 +228,33 @@ class ModalSamples:
         q = np.asarray(q, float).reshape(self._model.n_modes, -1)
         if part == "rotation" and self._model.phi.shape[1] < 6:
             return np.zeros(q.shape[1])
+        last = self._last_q
+        if last is None or last[0].shape != q.shape or not np.array_equal(last[0], q):
+            last = (q.copy(), self._motion_peaks(q))
+            self._last_q = last
+        return last[1][part]
+
+    def _motion_peaks(self, q: np.ndarray) -> dict[str, np.ndarray]:
+        """Translation and rotation peaks of every column of q, both from one pass."""
         nz = q != 0
         count = nz.sum(axis=0)
-        out = np.zeros(q.shape[1])
+        out = {part: np.zeros(q.shape[1]) for part in ("translation", "rotation")}
         single = np.flatnonzero(count == 1)
         if single.size:
             r = np.argmax(nz[:, single], axis=0)
-            out[single] = np.abs(q[r, single]) * self.shape_peaks(part)[r]
+            for part, peak in out.items():
+                peak[single] = np.abs(q[r, single]) * self.shape_peaks(part)[r]
         multi = np.flatnonzero(count > 1)
         if multi.size:
             rows = np.flatnonzero(nz[:, multi].any(axis=1))
-            motion = self._part(part)[:, :, rows] @ q[np.ix_(rows, multi)]
-            out[multi] = np.max(np.abs(motion), axis=(0, 1))
+            phi = self._model.phi
+            # one gather of all six rows (a slice when the rows are consecutive: a view)
+            consecutive = rows.size == rows[-1] - rows[0] + 1
+            sub = phi[:, :, rows[0] : rows[-1] + 1] if consecutive else phi[:, :, rows]
+            motion = np.abs(sub @ q[np.ix_(rows, multi)])  # (g, 6, k)
+            out["translation"][multi] = np.max(motion[:, :3], axis=(0, 1), initial=0.0)
+            if phi.shape[1] >= 6:
+                out["rotation"][multi] = np.max(motion[:, 3:6], axis=(0, 1), initial=0.0)
         return out
 
 
