@@ -31,7 +31,7 @@ from microg.dynamics.response import (
     PeakResponse,
     PointResponse,
     generalized_force_vector,
-    modal_pwl_response,
+    modal_pwl_evaluate,
     peak_response,
 )
 from microg.environment.metrics import Assessment, assess, band_mean_square
@@ -920,18 +920,29 @@ def _modal_forces(
 
 def _modal_acceleration(
     m: Modes, zeta: np.ndarray, loads: list[_Load], t: np.ndarray
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Modal displacement, velocity, acceleration (k, nt) of all loads superposed."""
-    eta = np.zeros((m.n_modes, t.size))
-    vel = np.zeros_like(eta)
-    acc = np.zeros_like(eta)
+) -> np.ndarray:
+    """Modal accelerations (k, nt) of all loads superposed, m/s^2 per modal unit."""
+    acc = np.zeros((m.n_modes, t.size))
     for ld in loads:
         f = ld.force
-        r = modal_pwl_response(m.omega, zeta, f.timepts, np.outer(ld.gamma, f.values), t)
-        eta += r.eta
-        vel += r.eta_dot
-        acc += r.eta_ddot
-    return eta, vel, acc
+        p = np.outer(ld.gamma, f.values)
+        acc += modal_pwl_evaluate(m.omega, zeta, f.timepts, p, t, derivatives=(2,))[0]
+    return acc
+
+
+def _point_motion(
+    m: Modes, zeta: np.ndarray, loads: list[_Load], t: np.ndarray, tphi: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Displacements and velocities (r, nt) of the rows ``tphi @ eta`` (m, m/s), all loads.
+
+    Contracted block by block: the modal displacements and velocities are never stored.
+    """
+    out = np.zeros((2, tphi.shape[0], t.size))
+    for ld in loads:
+        f = ld.force
+        p = np.outer(ld.gamma, f.values)
+        out += modal_pwl_evaluate(m.omega, zeta, f.timepts, p, t, derivatives=(0, 1), project=tphi)
+    return out[0], out[1]
 
 
 def _modal_accel_at(
@@ -947,7 +958,7 @@ def _modal_accel_at(
     order = np.argsort(tp, kind="stable")
     acc = np.empty((m.n_modes, tp.size))
     if tp.size:
-        acc[:, order] = _modal_acceleration(m, zeta, loads, tp[order])[2]
+        acc[:, order] = _modal_acceleration(m, zeta, loads, tp[order])
     return acc
 
 
@@ -1296,14 +1307,15 @@ def _transient(
     warnings += w
     step("response")
     t = np.arange(0.0, opts.duration_s + 0.5 * opts.dt_s, opts.dt_s)
-    eta, vel, acc = _modal_acceleration(m, zeta, loads, t)
+    acc = _modal_acceleration(m, zeta, loads, t)
     step("assessment")
     mode_numbers = idx + 1
     modal = _ModalSeries(t, acc)
     # every point's rows in one product per series (one GEMM, not one per point)
     rows = [tmap @ m.phi for tmap in maps.values()]
     tphi_all = np.concatenate(rows) if rows else np.zeros((0, m.n_modes))
-    d_all, v_all, a_all = tphi_all @ eta, tphi_all @ vel, tphi_all @ acc
+    d_all, v_all = _point_motion(m, zeta, loads, t, tphi_all)
+    a_all = tphi_all @ acc
     loads_b = [(ld.force, ld.b) for ld in loads]
     peaks = peak_response(m.omega, zeta, m.phi, maps, loads_b, t, grid_accel=a_all)
     acc_at_peaks = _modal_accel_at(m, zeta, loads, [peaks[name] for name in maps])

@@ -620,3 +620,31 @@ def test_piecewise_uniform_runs_equal_direct_evaluation_at_every_time(monkeypatc
         # the same closed form, the table path in another arithmetic order (products of two
         # tabulated exponentials, a few roundings per entry): rounding only, 1e-12 of the peak
         assert np.all(np.abs(getattr(tables, a) - ref) <= 1e-12 * scale), a
+
+
+def test_modal_pwl_evaluate_selects_and_projects_what_modal_pwl_response_gives():
+    """Reference: modal_pwl_response's full arrays (and their product with the projection).
+
+    The same closed form, so the selected derivatives are equal bit for bit; the projection
+    is contracted in blocks of times, another summation order: rounding, 1e-13 of the peak.
+    """
+    from microg.dynamics.response import modal_pwl_evaluate, modal_pwl_response
+
+    rng = np.random.default_rng(11)
+    omega = np.r_[0.0, 0.7, 2.9, 13.0]
+    zeta = np.r_[0.0, 0.02, 0.01, 0.05]
+    tf = np.array([0.0, 0.3, 0.3, 2.0, 5.0])
+    p = rng.standard_normal((4, 5))
+    t = np.r_[np.arange(0.0, 4.0, 0.01), np.linspace(4.0, 9.0, 37)[1:]]  # uniform + other
+    full = modal_pwl_response(omega, zeta, tf, p, t)
+    sel = modal_pwl_evaluate(omega, zeta, tf, p, t, derivatives=(2, 0))
+    np.testing.assert_array_equal(sel[0], full.eta_ddot)
+    np.testing.assert_array_equal(sel[1], full.eta)
+    proj = rng.standard_normal((3, 4))
+    pr = modal_pwl_evaluate(omega, zeta, tf, p, t, derivatives=(1,), project=proj)[0]
+    ref = proj @ full.eta_dot
+    np.testing.assert_allclose(pr, ref, rtol=0, atol=1e-13 * np.abs(ref).max())
+    with pytest.raises(InputError):
+        modal_pwl_evaluate(omega, zeta, tf, p, t, derivatives=(3,))
+    with pytest.raises(InputError):
+        modal_pwl_evaluate(omega, zeta, tf, p, t, project=np.ones((3, 5)))

@@ -66,6 +66,7 @@ __all__ = [
     "PointResponse",
     "combined_modal_force",
     "generalized_force_vector",
+    "modal_pwl_evaluate",
     "modal_pwl_response",
     "oscillator_functions",
     "peak_response",
@@ -790,6 +791,50 @@ def modal_pwl_response(
     st = _prepare(omega, zeta, timepts_force, modal_force)
     eta, eta_dot, eta_ddot = _evaluate(st, timepts_out, (0, 1, 2))
     return ModalResponse(timepts=timepts_out, eta=eta, eta_dot=eta_dot, eta_ddot=eta_ddot)
+
+
+def modal_pwl_evaluate(
+    omega: np.ndarray,
+    zeta: np.ndarray | float,
+    timepts_force: np.ndarray,
+    modal_force: np.ndarray,
+    timepts_out: np.ndarray,
+    *,
+    derivatives: Sequence[int] = (0, 1, 2),
+    project: np.ndarray | None = None,
+) -> np.ndarray:
+    """Selected derivatives of :func:`modal_pwl_response`'s exact response, optionally projected.
+
+    ``project @ eta^(d)`` is contracted block by block, so the modal array is never built.
+
+    Parameters
+    ----------
+    omega, zeta, timepts_force, modal_force, timepts_out
+        As :func:`modal_pwl_response` (rad/s, -, s, modal force, s).
+    derivatives : sequence of int
+        Time derivatives wanted, each 0 (eta), 1 (eta') or 2 (eta'').
+    project : ndarray (r, m), optional
+        Rows to contract the modes with (e.g. points' ``T phi``, m per modal unit).
+
+    Returns
+    -------
+    ndarray (len(derivatives), m or r, nt)
+        In the modal unit times the projection's unit, per s^d.
+    """
+    qs = tuple(int(d) for d in derivatives)
+    if not qs or any(d not in (0, 1, 2) for d in qs):
+        raise InputError(f"derivatives must be among 0, 1, 2, got {qs}", where="derivatives")
+    omega, zeta, timepts_force, modal_force, timepts_out = _as_arrays(
+        omega, zeta, timepts_force, modal_force, timepts_out
+    )
+    if project is not None:
+        project = np.asarray(project, float)
+        if project.ndim != 2 or project.shape[1] != omega.size:
+            raise InputError(
+                f"project must have shape (r, {omega.size}), got {project.shape}", where="project"
+            )
+    st = _prepare(omega, zeta, timepts_force, modal_force)
+    return _evaluate(st, timepts_out, qs, project)
 
 
 def generalized_force_vector(translation_map: np.ndarray, direction: np.ndarray) -> np.ndarray:
