@@ -997,8 +997,8 @@ class _ModalSeries:
 
     def peak_abs(self) -> np.ndarray:
         """``max_t |acc_j(t)|`` per mode, m/s^2 (k,)."""
-        if self._peak is None:
-            self._peak = np.max(np.abs(self.acc), axis=1)
+        if self._peak is None:  # max |x| = max(max x, -min x): no |acc| temporary
+            self._peak = np.maximum(self.acc.max(axis=1), -self.acc.min(axis=1))
         return self._peak
 
     def band_rms(self, center_hz: float, lower_hz: float, upper_hz: float) -> np.ndarray:

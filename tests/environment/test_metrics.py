@@ -566,3 +566,15 @@ def test_band_weights_are_kept_read_only_and_equal_a_fresh_computation():
         w1.data[0] = 1.0
     other = band_weights(f, f[1], 50.0, third_octave_bands(0.2, 40.0))
     assert other is not w1 and other.shape[0] < w1.shape[0]
+
+
+@pytest.mark.parametrize(
+    "bad, message",
+    [(np.nan, "not all finite"), (np.inf, "not all finite"), (0.0105, "uniformly spaced")],
+)
+def test_sample_rate_refuses_nonfinite_and_uneven_times(bad, message):
+    """A NaN or inf time anywhere (also mid-record) or an uneven step is refused by name."""
+    t = np.arange(100) * 0.01
+    t[50] = t[50] + bad if np.isfinite(bad) else bad
+    with pytest.raises(InputError, match=message):
+        acceleration_psd(t, np.ones(100))
