@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from microg._vectors import axis_name, parse_direction
+from microg.dynamics.dense import blas_threads
 from microg.dynamics.forces import ForceHistory, parse_force_spec
 from microg.dynamics.modes import DEFAULT_N_MODES, Modes, solve_modes
 from microg.dynamics.response import (
@@ -1191,7 +1192,10 @@ def run_analysis(
         # the vibratory regime reaches 300 Hz: sources need the modes well above it
         default = DEFAULT_SOURCE_MODES if opts.sources is not None else DEFAULT_N_MODES
         n_req = min(structure.n_dof - 1, opts.n_modes or default)
-    modes = solve_modes(structure, n_req)
+    # a small structure (a modal model: its modes; the IOC FEM) on one BLAS thread; a large
+    # one keeps the threads for its sparse eigensolve (solve_modes limits its own small steps)
+    with blas_threads(structure.n_dof):
+        modes = solve_modes(structure, n_req)
     warnings: list[str] = []
     elastic = getattr(modes, "elastic", ~modes.rigid)
     used = modes.rigid | (np.asarray(elastic) & (modes.freq_hz <= opts.max_freq_hz))
@@ -1199,7 +1203,11 @@ def run_analysis(
     t = np.zeros(0)
     if opts.disturbances:
         warnings += _check_modes_used(modes, np.asarray(elastic, bool), used, opts.max_freq_hz)
-        observations, t, w = _transient(structure, modes, used, opts, req, step)
+        # the transient's products contract over the modes (a few hundred): small GEMMs, on
+        # one BLAS thread (two contend with each other and with the provenance hash: the
+        # issue-11 benchmark's point projections take 0.045 s on one, 0.08-0.15 s on two)
+        with blas_threads(modes.n_modes):
+            observations, t, w = _transient(structure, modes, used, opts, req, step)
         warnings += w
     vib = None
     if opts.sources is not None:
