@@ -1115,12 +1115,9 @@ class _Provenance:
 
 
 def _sha256_file(path: Path) -> str:
-    """SHA-256 of a file, read in 8-MiB blocks (never the whole file in memory at once)."""
-    h = hashlib.sha256()
+    """SHA-256 of a file (``hashlib.file_digest``: read into one reused buffer)."""
     with path.open("rb") as fh:
-        while block := fh.read(1 << 23):
-            h.update(block)
-    return h.hexdigest()
+        return hashlib.file_digest(fh, "sha256").hexdigest()
 
 
 def _meta(model: Any, command: str | None) -> dict[str, Any]:
@@ -1177,7 +1174,6 @@ def run_analysis(
     step = progress or (lambda _s: None)
     _check_record(opts)
     req = requirement or _requirement(opts.requirement)
-    provenance = _Provenance(model, command)
     step("structure")
     structure = _structure(model, opts)
     for d in opts.disturbances:
@@ -1196,6 +1192,9 @@ def run_analysis(
     # one keeps the threads for its sparse eigensolve (solve_modes limits its own small steps)
     with blas_threads(structure.n_dof):
         modes = solve_modes(structure, n_req)
+    # the model file's hash runs beside the response and assessment (compute-bound), not the
+    # structure and modes, whose scans of the mode shapes compete with it for memory bandwidth
+    provenance = _Provenance(model, command)
     warnings: list[str] = []
     elastic = getattr(modes, "elastic", ~modes.rigid)
     used = modes.rigid | (np.asarray(elastic) & (modes.freq_hz <= opts.max_freq_hz))
