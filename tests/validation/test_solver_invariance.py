@@ -12,7 +12,7 @@ modes of models with a penalty stiffness are checked to 1e-7: see the comment be
 from __future__ import annotations
 
 import numpy as np
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from microg.dynamics.modes import solve_modes
@@ -111,6 +111,7 @@ def _rotation(rng: np.random.Generator) -> np.ndarray:
     n_beams=st.integers(1, 4),
     offset=st.floats(-200.0, 200.0),
 )
+@example(seed=339, n_beams=3, offset=4.0)  # a high mode off by 1.09e-7 (see the tolerance)
 @settings(max_examples=25, deadline=None)
 def test_modes_invariant_under_rigid_motion_of_the_model(seed: int, n_beams: int, offset: float):
     base = random_tree(seed, n_beams)
@@ -131,7 +132,9 @@ def test_modes_invariant_under_rigid_motion_of_the_model(seed: int, n_beams: int
         # the modes up to 100x the first elastic frequency (the solvers' first, exact level:
         # the tree flexibility or the unshifted inverse, ~1e-12) to 1e-9; the higher modes of
         # a model with an axially rigid massless beam (a penalty 1e6 x its bending stiffness)
-        # carry that stiffness spread times the rounding of the assembly (measured <= 5e-9)
+        # carry that stiffness spread times the rounding of the assembly: the penalty (1e6)
+        # times the trees' own spread (EI 1e5-1e8 over lengths 1-15 m: ~1e3) is a condition
+        # of ~1e9, so ~1e9 x eps = 2e-7 (hypothesis found 1.09e-7: the example above); 1e-6
         low = wa <= 100.0 * wa[0]
         np.testing.assert_allclose(wb[low], wa[low], rtol=1e-9 * scale)
-        np.testing.assert_allclose(wb, wa, rtol=1e-7 * scale)
+        np.testing.assert_allclose(wb, wa, rtol=1e-6 * scale)
