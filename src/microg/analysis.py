@@ -919,31 +919,35 @@ def _modal_forces(
     return loads, warnings
 
 
+def _superposed(
+    m: Modes,
+    zeta: np.ndarray,
+    loads: list[_Load],
+    t: np.ndarray,
+    derivatives: tuple[int, ...],
+    project: np.ndarray | None = None,
+) -> np.ndarray:
+    """The exact response of all loads superposed (:func:`modal_pwl_evaluate`).
+
+    ``derivatives`` of the modal coordinates, (len, k, nt), or of the rows ``project @ eta``
+    contracted block by block, (len, r, nt).
+    """
+    rows = m.n_modes if project is None else project.shape[0]
+    out = np.zeros((len(derivatives), rows, t.size))
+    for ld in loads:
+        f = ld.force
+        p = np.outer(ld.gamma, f.values)
+        out += modal_pwl_evaluate(
+            m.omega, zeta, f.timepts, p, t, derivatives=derivatives, project=project
+        )
+    return out
+
+
 def _modal_acceleration(
     m: Modes, zeta: np.ndarray, loads: list[_Load], t: np.ndarray
 ) -> np.ndarray:
     """Modal accelerations (k, nt) of all loads superposed, m/s^2 per modal unit."""
-    acc = np.zeros((m.n_modes, t.size))
-    for ld in loads:
-        f = ld.force
-        p = np.outer(ld.gamma, f.values)
-        acc += modal_pwl_evaluate(m.omega, zeta, f.timepts, p, t, derivatives=(2,))[0]
-    return acc
-
-
-def _point_motion(
-    m: Modes, zeta: np.ndarray, loads: list[_Load], t: np.ndarray, tphi: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
-    """Displacements and velocities (r, nt) of the rows ``tphi @ eta`` (m, m/s), all loads.
-
-    Contracted block by block: the modal displacements and velocities are never stored.
-    """
-    out = np.zeros((2, tphi.shape[0], t.size))
-    for ld in loads:
-        f = ld.force
-        p = np.outer(ld.gamma, f.values)
-        out += modal_pwl_evaluate(m.omega, zeta, f.timepts, p, t, derivatives=(0, 1), project=tphi)
-    return out[0], out[1]
+    return _superposed(m, zeta, loads, t, (2,))[0]
 
 
 def _modal_accel_at(
@@ -1321,7 +1325,8 @@ def _transient(
     # every point's rows in one product per series (one GEMM, not one per point)
     rows = [tmap @ m.phi for tmap in maps.values()]
     tphi_all = np.concatenate(rows) if rows else np.zeros((0, m.n_modes))
-    d_all, v_all = _point_motion(m, zeta, loads, t, tphi_all)
+    # displacements and velocities at the points only (the modal ones are never stored)
+    d_all, v_all = _superposed(m, zeta, loads, t, (0, 1), tphi_all)
     a_all = tphi_all @ acc
     loads_b = [(ld.force, ld.b) for ld in loads]
     peaks = peak_response(m.omega, zeta, m.phi, maps, loads_b, t, grid_accel=a_all)

@@ -204,10 +204,6 @@ class ModalSamples:
             self._peaks["rotation"] = rot.max(axis=0) if rot.shape[0] else np.zeros(phi.shape[2])
         return self._peaks[part]
 
-    def _part(self, part: str) -> np.ndarray:
-        """The translational (g, 3, m) or rotational rows of the shapes, a view."""
-        return self._model.phi[:, :3, :] if part == "translation" else self._model.phi[:, 3:6, :]
-
     def peak_translation(self, q: np.ndarray) -> np.ndarray:
         """``max over grids and axes of |displacement(q)|`` per column of q (k,).
 
