@@ -19,7 +19,9 @@ processes, each doing what the command does, stage by stage): imports (what the 
 before it computes), model load, structure, modes, response, assessment, exact peaks,
 isolation, figures (build and render), HTML, write; each stage lists the heavy libraries it
 loads first.  The stage times add up to the in-process total; the command's own wall time
-adds the interpreter start.
+adds the interpreter start.  Each profiled process starts as the ``microg`` process does
+(:func:`microg.cli._startup.install`); the serial column draws the figures in-process, the
+helpers column as ``microg analyze`` does (helper processes forked before the model load).
 
 Run:  .venv/bin/python benchmarks/bench_cli.py            (about 40 s on the 2-core machine)
       .venv/bin/python benchmarks/bench_cli.py --figures  (also the time of each figure)
@@ -117,25 +119,7 @@ def _run(argv: list[str], env: dict[str, str]) -> tuple[float, float, bytes]:
     return wall, cpu, proc.stdout
 
 
-#: the analyze row run through :data:`_PROPOSED_DRIVER` while the CLI is not wired
-PROPOSED = "microg analyze --json (helpers)"
-
-#: ``microg analyze`` with the renderer wired as proposed for cli/analyze.py
-_PROPOSED_DRIVER = """
-import sys
-import microg.cli.analyze
-import microg.report.analysis as rep
-from microg.cli import main
-renderer = rep.start_renderer()
-_figures = rep.figures
-rep.figures = lambda result, renderer_=None: _figures(result, renderer_ or renderer)
-code = main(sys.argv[1:])
-renderer.close()
-sys.exit(code)
-"""
-
-
-def timings(runs: int, tmp: Path, proposed: bool = False) -> dict[str, dict[str, float]]:
+def timings(runs: int, tmp: Path) -> dict[str, dict[str, float]]:
     """Median wall and CPU time of each command over ``runs`` round-robin runs."""
     py = sys.executable
     mg = _microg_command()
@@ -147,14 +131,12 @@ def timings(runs: int, tmp: Path, proposed: bool = False) -> dict[str, dict[str,
         "microg modes ioc --json": [*mg, "modes", "ioc", "--json"],
         analyze: [*mg, "analyze"],
     }
-    if proposed:
-        cases[PROPOSED] = [py, "-c", _PROPOSED_DRIVER, "analyze"]
     walls: dict[str, list[float]] = {k: [] for k in cases}
     cpus: dict[str, list[float]] = {k: [] for k in cases}
 
     def argv_of(name: str, out: Path) -> list[str]:
         argv = cases[name]
-        if name in (analyze, PROPOSED):  # a fresh --out per run
+        if name == analyze:  # a fresh --out per run
             argv = [*argv, "--json", "--no-progress", "--out", str(out)]
         return argv
 
@@ -165,7 +147,7 @@ def timings(runs: int, tmp: Path, proposed: bool = False) -> dict[str, dict[str,
         for k, name in enumerate(cases):
             out = tmp / f"run{r}-{k}"
             wall, cpu, stdout = _run(argv_of(name, out), env)
-            if name in (analyze, PROPOSED):
+            if name == analyze:
                 data = json.loads(stdout)
                 assert "observations" in data, "analyze --json printed no observations"
                 assert (out / "report.html").is_file(), "no report.html written"
@@ -200,6 +182,9 @@ def _profile_child(out_dir: str, per_figure: bool, helpers: bool) -> dict[str, A
     t0, c0 = time.perf_counter(), time.process_time()
     mods0 = set(sys.modules)
 
+    from microg.cli._startup import install
+
+    install()  # what the microg process does first (BLAS threads, lazy imports)
     import microg
     import microg.cli
     import microg.cli.analyze as cli_analyze
@@ -262,10 +247,7 @@ def _profile_child(out_dir: str, per_figure: bool, helpers: bool) -> dict[str, A
 
     result = microg.analyze(progress=mark, command="microg analyze --json")
     mark("write")
-    cli_analyze.write_outputs(result, Path(out_dir))
-    from microg._io import dumps
-
-    dumps(result.to_dict())  # what --json prints
+    cli_analyze.write_outputs(result, Path(out_dir), renderer)  # + the JSON --json prints
     mark("end")
     if renderer is not None:
         renderer.close()
@@ -332,15 +314,6 @@ def _median_of(rows: list[dict[str, Any]], key: str, sub: str | None = None) -> 
     return statistics.median(vals)
 
 
-def cli_uses_helpers() -> bool:
-    """Whether ``microg analyze`` hands a renderer to ``write_outputs`` (issue 8 wiring)."""
-    import inspect
-
-    import microg.cli.analyze as cli_analyze
-
-    return "renderer" in inspect.signature(cli_analyze.write_outputs).parameters
-
-
 def main() -> None:
     """Run the benchmark and print the table and the profile."""
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
@@ -360,8 +333,7 @@ def main() -> None:
             f"python {sys.version.split()[0]}, {os.cpu_count()} CPUs, load average "
             f"{' '.join(f'{x:.2f}' for x in os.getloadavg())}"
         )
-        wired = cli_uses_helpers()
-        res = timings(args.runs, tmp, proposed=not wired)
+        res = timings(args.runs, tmp)
         base = res["python -c 'import numpy'"]
         print(f"\nmedian of {args.runs} fresh processes (round-robin with the baseline)")
         print(
@@ -376,12 +348,6 @@ def main() -> None:
                 f"{name:<40} {t['wall']:>9.3f} {ratio:>6.2f}x "
                 f"{'' if target is None else f'{target:.0f}x':>7} {t['cpu']:>8.3f} "
                 f"{t['cpu'] / base['cpu']:>8.2f}x{flag}"
-            )
-        if not wired:
-            print(
-                f"  {PROPOSED!r}: microg analyze with the figures drawn by helper processes "
-                "started before the computation (microg.report.analysis.start_renderer), as "
-                "cli/analyze.py would do it (cpu includes the helpers)"
             )
         bad = forbidden_imports()
         listed = ", ".join(bad) if bad else "none of " + ", ".join(FORBIDDEN)

@@ -54,6 +54,16 @@ os.kill(r._pid, 9)
 out["killed"] = [r.render(one, 1), r.error is not None]
 r = FigureRenderer.start((), processes=2)
 out["tiny"] = r.render(one, 1)
+import microg.report.render as render_module
+render_module.MAX_PAYLOAD_BYTES = 1000
+r = FigureRenderer.start((), processes=2)
+out["large"] = [r.render(one, b"x" * 2000), "MB" in (r.error or ""), r.active]
+calls = []
+with rep.start_renderer(processes=2) as r:  # figures() runs while_waiting once on each path
+    rep.figures(result, r, while_waiting=lambda: calls.append("helpers"))
+    rep.figures(result, r, while_waiting=lambda: calls.append("closed"))
+rep.figures(result, None, while_waiting=lambda: calls.append("none"))
+out["while_waiting"] = calls
 import time
 r = FigureRenderer.start(rep.PRELOAD, processes=2)  # busy importing matplotlib
 t = time.monotonic()
@@ -89,6 +99,15 @@ def test_a_failing_helper_means_drawing_in_process(forked):
     assert forked["failing"] == [None, True]  # None: the caller draws; the error is kept
     assert forked["unpicklable"] == [None, True]
     assert forked["killed"] == [None, True]
+
+
+def test_a_large_result_is_drawn_in_process(forked):
+    # a request above MAX_PAYLOAD_BYTES (a large model's mode shapes) is not sent
+    assert forked["large"] == [None, True, False]
+
+
+def test_the_callers_work_runs_once_on_every_path(forked):
+    assert forked["while_waiting"] == ["helpers", "closed", "none"]
 
 
 def test_helpers_share_the_jobs_and_stop(forked):

@@ -12,8 +12,7 @@ import re
 import pint
 import pytest
 
-from microg.plotting.common import png_data_uri
-from microg.report.html import render_reproduction
+from microg.report.html import png_data_uri, render_reproduction
 from microg.seed.nomenclature import NOMENCLATURE, nomenclature
 from microg.seed.reproduce import reproduce
 

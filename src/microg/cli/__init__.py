@@ -78,6 +78,10 @@ def main(argv: list[str] | None = None) -> int:
     took ~0.25 s of a 2-s ``microg analyze`` (issue 8), for memory the exit frees anyway.
     The exit itself (atexit handlers, stream flushes, module teardown) is unchanged.
     """
+    if argv is None:
+        from microg.cli._startup import install
+
+        install()
     try:
         return _run(argv)
     finally:

@@ -7,6 +7,7 @@ name its parameters, which :func:`flag_errors` maps back to the options.
 
 from __future__ import annotations
 
+import contextlib
 import shlex
 import sys
 from pathlib import Path
@@ -269,8 +270,9 @@ def analyze(
 
     command = "microg " + " ".join(shlex.quote(a) for a in sys.argv[1:])
     reader = {k: v for k, v in (("units", units), ("wtmass", wtmass), ("points", points_file)) if v}
-    with flag_errors(FLAGS):
-        mdl = microg.load_model(model, **reader) if reader else model
+    with flag_errors(FLAGS), contextlib.ExitStack() as stack:
+        renderer = stack.enter_context(_renderer())
+        mdl = microg.load_model(model, **reader)
         result = microg.analyze(
             mdl,
             force=list(forces) or None,
@@ -287,15 +289,29 @@ def analyze(
             **kwargs,
         )
         progress("report")
-        path = write_outputs(result, out_dir)
+        path, text = write_outputs(result, out_dir, renderer)
     bar.update(1)
     bar.close()
     if as_json:
-        from microg._io import dumps
-
-        click.echo(dumps(result.to_dict()))
+        click.echo(text)
     else:
         summary(result, path)
+
+
+def _renderer() -> Any:
+    """Helper processes for the figures (:func:`microg.report.analysis.start_renderer`).
+
+    Only the ``microg`` process starts them, once the model is loaded: they import
+    matplotlib and draw the figures on the second core while this process computes (issue
+    8).  A library caller of :func:`main` draws in-process, as ``microg.analyze`` users do.
+    """
+    from microg.cli._startup import is_process
+
+    if not is_process():
+        return contextlib.nullcontext(None)
+    from microg.report.analysis import start_renderer
+
+    return start_renderer()
 
 
 def _check_out(out_dir: Path) -> None:
@@ -310,16 +326,25 @@ def _check_out(out_dir: Path) -> None:
     check_writable(out_dir, where="--out")
 
 
-def write_outputs(result: Any, out_dir: Path) -> Path:
-    """Render figures, HTML and JSON, and write them into ``out_dir`` as one run."""
+def write_outputs(result: Any, out_dir: Path, renderer: Any = None) -> tuple[Path, str]:
+    """Render figures, HTML and JSON, and write them into ``out_dir`` as one run.
+
+    Returns the directory and the JSON text (``result.to_dict()``, what ``--json`` prints),
+    which is written while the ``renderer``'s helpers, if any, draw the figures.
+    """
     from microg._io import dumps, write_output_files
     from microg.report.analysis import figures, render_analysis
 
-    figs = figures(result)
+    box: dict[str, str] = {}
+
+    def json_text() -> None:
+        box["json"] = dumps(result.to_dict())
+
+    figs = figures(result, renderer, while_waiting=json_text)
     html = render_analysis(result, figs)
-    text = dumps(result.to_dict())
+    text = box["json"]
     files: dict[str, bytes | str] = {**figs, "report.html": html, "results.json": text}
-    return write_output_files(out_dir, files, where="--out")
+    return write_output_files(out_dir, files, where="--out"), text
 
 
 def summary(result: Any, path: Path) -> None:

@@ -124,9 +124,9 @@ def reproduce(
     from microg._io import check_writable, dumps, write_run_directory
     from microg.cli._errors import flag_errors
     from microg.dynamics.crew import CrewPushoff
-    from microg.plotting.common import png_bytes, png_data_uri
+    from microg.plotting.common import png_bytes
     from microg.plotting.seed import figure3, figure4, point_response_figure
-    from microg.report.html import render_reproduction
+    from microg.report.html import png_data_uri, render_reproduction
     from microg.seed.ioc import FT
     from microg.seed.reproduce import ReproduceOptions
     from microg.seed.reproduce import reproduce as run

@@ -35,6 +35,7 @@ Method (:func:`solve_dense`), each step a documented choice:
 
 from __future__ import annotations
 
+import os
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -80,12 +81,22 @@ BLAS_THREADS_MIN_N = 4000
 _CONTROLLER: Any = None
 
 
+def _large() -> int | None:
+    """Threads for a large problem: ``MICROG_BLAS_CORES`` if set, else as they are (None)."""
+    try:
+        return max(1, int(os.environ["MICROG_BLAS_CORES"]))
+    except (KeyError, ValueError):
+        return None
+
+
 @contextmanager
 def blas_threads(n: int, threads: int | None = None) -> Iterator[None]:
     """Limit BLAS to one thread (or ``threads``) for a problem of dimension ``n``.
 
     Below :data:`BLAS_THREADS_MIN_N` the thread start-up and contention of OpenBLAS cost
-    far more than the work (see the constant); above it the threads are left as they are.
+    far more than the work (see the constant); above it the threads are left as they are,
+    except in a ``microg`` process that started BLAS on one thread (``MICROG_BLAS_CORES``,
+    set by :mod:`microg.cli._startup`), where a large problem gets the usable cores back.
 
     Parameters
     ----------
@@ -95,7 +106,7 @@ def blas_threads(n: int, threads: int | None = None) -> Iterator[None]:
         An explicit count (None: by the rule above).
     """
     global _CONTROLLER
-    want = threads if threads is not None else (1 if n < BLAS_THREADS_MIN_N else None)
+    want = threads if threads is not None else (1 if n < BLAS_THREADS_MIN_N else _large())
     if want is None:
         yield
         return

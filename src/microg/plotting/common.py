@@ -19,7 +19,6 @@ They are drawn for speed as well as legibility (issue 8, "Speed of the main job"
 
 from __future__ import annotations
 
-import base64
 import math
 import re
 import struct
@@ -46,7 +45,6 @@ __all__ = [
     "new_figure",
     "plain_axes",
     "png_bytes",
-    "png_data_uri",
     "set_margins",
 ]
 
@@ -527,8 +525,3 @@ def encode_png(rgba: np.ndarray, level: int = 1) -> bytes:
             _png_chunk(b"IEND", b""),
         )
     )
-
-
-def png_data_uri(png: bytes) -> str:
-    """A ``data:image/png;base64,...`` URI for embedding ``png`` in HTML."""
-    return "data:image/png;base64," + base64.b64encode(png).decode("ascii")

@@ -151,7 +151,11 @@ def _observation_jobs(job: Any, s: str, name: str, ob: Any) -> list[FigureJob]:
     return out
 
 
-def figures(result: Analysis, renderer: FigureRenderer | None = None) -> dict[str, bytes]:
+def figures(
+    result: Analysis,
+    renderer: FigureRenderer | None = None,
+    while_waiting: Callable[[], object] | None = None,
+) -> dict[str, bytes]:
     """PNG bytes of every figure of the report, keyed by file name, in report order.
 
     Parameters
@@ -159,14 +163,29 @@ def figures(result: Analysis, renderer: FigureRenderer | None = None) -> dict[st
     result : Analysis
     renderer : FigureRenderer, optional
         Helper processes started before the computation (see :mod:`microg.report.render`):
-        they draw the figures while this process loads the HTML template.  Without one, or
-        if it fails, the figures are drawn here (the default, and the fastest on two
-        cores), with the cyclic garbage collector paused.  The bytes are the same either way.
+        they draw the figures while this process loads the HTML template and runs
+        ``while_waiting``.  Without one, or if it fails, the figures are drawn here (the
+        library's default), with the cyclic garbage collector paused.  The bytes are the
+        same either way.
+    while_waiting : callable, optional
+        Work of the caller's to do while helpers draw (run in any case, before drawing
+        in-process when there are none).
     """
+    done = False
+
+    def meanwhile() -> None:
+        nonlocal done
+        _analysis_template()
+        if while_waiting is not None:
+            while_waiting()
+        done = True
+
     if renderer is not None and renderer.active:
-        out = renderer.render(figure_jobs, result, while_waiting=_analysis_template)
+        out = renderer.render(figure_jobs, result, while_waiting=meanwhile)
         if out is not None:
             return out
+    if while_waiting is not None and not done:  # exactly once, on every path
+        while_waiting()
     with _collector_paused():
         return {j.name: j.draw() for j in figure_jobs(result)}
 
@@ -188,8 +207,18 @@ def _collector_paused() -> Iterator[None]:
             gc.enable()
 
 
-#: what a renderer for :func:`figures` preloads
-PRELOAD = ("microg.plotting.analysis", "microg.plotting.environment", "microg.report.analysis")
+#: what a renderer for :func:`figures` preloads: the figure modules, and the modules an
+#: :class:`~microg.analysis.Analysis` needs to unpickle (its structure's) that a caller
+#: forking before the computation has not imported yet
+PRELOAD = (
+    "microg.plotting.analysis",
+    "microg.plotting.environment",
+    "microg.report.analysis",
+    "microg.models.graph",
+    "microg.models.toml",
+    "microg.structure.fem",
+    "microg.structure.frame",
+)
 
 
 def start_renderer(processes: int | None = None) -> FigureRenderer:
@@ -215,7 +244,7 @@ def _analysis_template() -> Any:
 def render_analysis(result: Analysis, figs: dict[str, bytes]) -> str:
     """Self-contained HTML of the analysis, figures embedded as data URIs."""
     from microg import __version__
-    from microg.plotting.common import png_data_uri
+    from microg.report.html import png_data_uri
 
     data = to_jsonable(result.to_dict())
     uris = {k: png_data_uri(v) for k, v in figs.items()}

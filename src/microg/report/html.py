@@ -9,6 +9,7 @@ the main job").  Without a usable cache directory the templates are compiled as 
 
 from __future__ import annotations
 
+import base64
 import contextlib
 from functools import lru_cache
 from typing import TYPE_CHECKING
@@ -29,7 +30,12 @@ from microg._io import to_jsonable
 if TYPE_CHECKING:  # the seed reproduction loads only for its own report (~0.1 s)
     from microg.seed.reproduce import Reproduction
 
-__all__ = ["render_reproduction", "environment", "id_ranges"]
+__all__ = ["render_reproduction", "environment", "id_ranges", "png_data_uri"]
+
+
+def png_data_uri(png: bytes) -> str:
+    """A ``data:image/png;base64,...`` URI for embedding ``png`` in HTML."""
+    return "data:image/png;base64," + base64.b64encode(png).decode("ascii")
 
 
 def id_ranges(ids: list[str]) -> list[tuple[str, str]]:

@@ -9,18 +9,21 @@ while the caller prepares the HTML.  The caller itself never imports matplotlib.
 
 The PNG bytes are the same as those drawn in-process: the helpers are forks of the caller,
 with its matplotlib settings.  Anything unexpected (no ``os.fork``, one CPU, other threads
-running in the caller, a result that does not pickle, a helper that fails or dies) makes
+running in the caller, a result that does not pickle or pickles larger than
+:data:`MAX_PAYLOAD_BYTES`, a helper that fails or dies) makes
 :meth:`FigureRenderer.render` return ``None``, and the caller draws in-process as before.
 The environment variable ``MICROG_FIGURE_PROCESSES`` sets the number of drawing processes
 (``1``: no helper; default: 2 where two CPUs are available).
 
-This is for a command-line run (one process per job).  A library caller (a notebook, a
-server) draws in-process: :func:`microg.report.analysis.figures` without a renderer.
+This is for a command-line run (one process per job): ``microg analyze`` starts one before
+it loads the model (:mod:`microg.cli.analyze`).  A library caller (a notebook, a server)
+draws in-process: :func:`microg.report.analysis.figures` without a renderer.
 """
 
 from __future__ import annotations
 
 import contextlib
+import gc
 import importlib
 import os
 import pickle
@@ -44,6 +47,9 @@ MAX_PROCESSES = 2
 
 #: seconds a helper may take before the caller gives up on it and draws in-process
 TIMEOUT_S = 600.0
+
+#: a pickled request larger than this is drawn in-process instead (bytes)
+MAX_PAYLOAD_BYTES = 64_000_000
 
 _HEADER = struct.Struct("<Q")
 
@@ -95,7 +101,11 @@ def split_jobs(weights: Sequence[float], parts: int) -> list[list[int]]:
 
 
 def _send(fd: int, obj: Any) -> None:
-    data = pickle.dumps(obj, protocol=pickle.HIGHEST_PROTOCOL)
+    _write_all(fd, pickle.dumps(obj, protocol=pickle.HIGHEST_PROTOCOL))
+
+
+def _write_all(fd: int, data: bytes) -> None:
+    """``data`` (pickled bytes) written whole, framed by its length."""
     view = memoryview(_HEADER.pack(len(data)) + data)
     while view:
         n = os.write(fd, view)
@@ -167,6 +177,10 @@ def _helper(preload: Sequence[str], requests: int, replies: int, processes: int)
     """The helper process: load, wait for one request, draw, reply, exit."""
     status = 0
     try:
+        # the helper exits by os._exit once it has replied: its objects never need
+        # collecting, and collections over matplotlib's heap would slow the imports and the
+        # drawing (as :func:`microg.report.analysis.figures` pauses it in-process)
+        gc.disable()
         for name in preload:
             importlib.import_module(name)
         with contextlib.suppress(Exception):
@@ -296,8 +310,20 @@ class FigureRenderer:
         if self._pid is None or self._requests is None or self._replies is None:
             return None
         try:
-            _send(self._requests, (make_jobs, payload))
+            data = pickle.dumps((make_jobs, payload), protocol=pickle.HIGHEST_PROTOCOL)
         except Exception as exc:  # e.g. a payload that does not pickle
+            self.error = f"{type(exc).__name__}: {exc}"
+            self.close()
+            return None
+        if len(data) > MAX_PAYLOAD_BYTES:
+            # a large model's result (issue 11: 193 MB of mode shapes): copying it through
+            # the pipe and unpickling it costs more than drawing here saves
+            self.error = f"the result is {len(data) / 1e6:.0f} MB: drawn in-process"
+            self.close()
+            return None
+        try:
+            _write_all(self._requests, data)
+        except OSError as exc:
             self.error = f"{type(exc).__name__}: {exc}"
             self.close()
             return None

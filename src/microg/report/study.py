@@ -42,8 +42,7 @@ def render_sweep(
     requirement_source : citation of the requirement
     """
     from microg import __version__
-    from microg.plotting.common import png_data_uri
-    from microg.report.html import environment
+    from microg.report.html import environment, png_data_uri
     from microg.study.plan import CASE_DIMS
 
     data = to_jsonable(summary.to_dict())
