@@ -966,9 +966,11 @@ def band_mean_square(timepts: np.ndarray, accel: np.ndarray, bands: BandTable) -
     if cols.size > _DFT_MAX_BINS or n * cols.size > _DFT_MAX_ENTRIES:
         _, psd = _periodogram(x, fs)
         return np.asarray(w @ psd.T).T
-    phase = (2.0 * np.pi / n) * ((np.arange(n)[:, None] * cols[None, :]) % n)
-    re = x @ np.cos(phase)
-    im = x @ np.sin(phase)
+    # the N roots of unity once, gathered at the exact integer phases (k n) mod N
+    arg = (2.0 * np.pi / n) * np.arange(n)
+    idx = (np.arange(n)[:, None] * cols[None, :]) % n
+    re = x @ np.cos(arg)[idx]
+    im = x @ np.sin(arg)[idx]
     scale = np.where((cols == 0) | (2 * cols == n), 1.0, 2.0) / (fs * n)
     psd = (re * re + im * im) * scale
     return np.asarray(w[:, cols] @ psd.T).T
@@ -1060,10 +1062,12 @@ def integrated_acceleration(
     )
     span = t[-1] - t[0]
     window = min(window_s, span)
-    starts = t[t + window <= t[-1] + 1e-12 * max(1.0, abs(t[-1]))]
+    # the windows start at a prefix of the samples (t sorted), their ends interpolated in the
+    # running integral
+    n_win = int(np.count_nonzero(t + window <= t[-1] + 1e-12 * max(1.0, abs(t[-1]))))
+    starts = t[:n_win]
     ends = np.minimum(starts + window, t[-1])
-    i0 = np.searchsorted(t, starts)
-    dv = np.array([np.interp(ends, t, c) - c[i0] for c in cum])
+    dv = np.array([np.interp(ends, t, c) - c[:n_win] for c in cum])
     return IntegratedAcceleration(
         window_s=float(window),
         t_start=starts,
