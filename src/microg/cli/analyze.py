@@ -301,9 +301,10 @@ def analyze(
 def _renderer() -> Any:
     """Helper processes for the figures (:func:`microg.report.analysis.start_renderer`).
 
-    Only the ``microg`` process starts them, once the model is loaded: they import
-    matplotlib and draw the figures on the second core while this process computes (issue
-    8).  A library caller of :func:`main` draws in-process, as ``microg.analyze`` users do.
+    Only the ``microg`` process starts them, before it loads the model: they import
+    matplotlib (and the modules the result unpickles with) on the second core while this
+    process loads and computes, then draw the figures (issue 8).  A library caller of
+    :func:`main` draws in-process, as ``microg.analyze`` users do.
     """
     from microg.cli._startup import is_process
 
