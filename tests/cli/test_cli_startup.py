@@ -170,6 +170,15 @@ def test_blas_starts_on_one_thread_and_large_problems_get_the_cores():
     assert out["large"] == [out["usable"]]
 
 
+def test_the_cores_variable_is_the_one_blas_threads_reads(monkeypatch):
+    from microg.dynamics.dense import _large
+
+    monkeypatch.setenv(CORES_ENV, "3")
+    assert _large() == 3  # the name _startup sets is the name dense reads
+    monkeypatch.delenv(CORES_ENV)
+    assert _large() is None
+
+
 def test_a_users_blas_thread_count_is_kept():
     out = _py(BLAS, OPENBLAS_NUM_THREADS="2")
     assert out["cores"] is None  # not set: the user chose

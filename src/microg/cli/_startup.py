@@ -50,7 +50,8 @@ LAZY = frozenset({"numpy.f2py", "numpy.testing"})
 
 #: environment variables by which a user sets the BLAS thread count
 BLAS_ENV = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS", "BLIS_NUM_THREADS")
-#: the usable cores, for the problems that use them (read by ``dense.blas_threads``)
+#: the usable cores, for the problems that use them; ``dense._large`` reads the same name
+#: (this module runs before numpy loads, so it cannot import ``microg.dynamics.dense``)
 CORES_ENV = "MICROG_BLAS_CORES"
 
 #: whether this interpreter is the ``microg`` process (set by :func:`install`)
