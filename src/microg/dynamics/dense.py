@@ -42,7 +42,6 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-import scipy.linalg as sla
 
 from microg.dynamics.rigid import RIGID_TOL, m_orthonormal, rigid_basis, support_coordinates
 from microg.errors import InputError, SolverError
@@ -222,13 +221,15 @@ def _shifted_cholesky(
     Tries ``s0`` (0 first), then ``scale * 10^(-16 + 2 j)``; None when no shift up to
     ``1e6 scale`` works (a zero-mass, zero-stiffness direction).
     """
+    import scipy.linalg as sla
+
     trials = [s0] + [scale * 10.0 ** (-16 + 2 * j) for j in range(12)]
     for s in trials:
         if s < s0:
             continue
         try:
             return s, sla.cholesky(k + s * m, lower=False, check_finite=False)
-        except sla.LinAlgError:
+        except np.linalg.LinAlgError:
             continue
     return s0, None
 
@@ -277,6 +278,8 @@ def graded_eigh(
         When ``K + s M`` is singular for every shift (a massless, unrestrained direction);
         ``err.vector`` holds that direction.
     """
+    import scipy.linalg as sla
+
     k = 0.5 * (stiffness + stiffness.T)
     m = 0.5 * (mass + mass.T)
     n = k.shape[0]
@@ -301,9 +304,9 @@ def graded_eigh(
         fac = sla.cho_factor(koo, lower=False, check_finite=False)
         piv = np.abs(np.diag(fac[0]))
         if piv.min() <= 1e-7 * piv.max():  # K_oo's condition beyond ~1e14
-            raise sla.LinAlgError("near-singular")
+            raise np.linalg.LinAlgError("near-singular")
         xo = -sla.cho_solve(fac, koa, check_finite=False)
-    except sla.LinAlgError:
+    except np.linalg.LinAlgError:
         w, v = np.linalg.eigh(koo)
         if w.min() > 1e-14 * max(abs(w).max(), 1e-300):
             # indefinite but regular (a negative stiffness on a massless part): a symmetric
@@ -327,6 +330,8 @@ def graded_eigh(
 
 def _m_complement(m: np.ndarray, d: np.ndarray) -> np.ndarray:
     """Orthonormal basis (Euclidean) of the M-orthogonal complement of span(d)."""
+    import scipy.linalg as sla
+
     return np.asarray(sla.null_space(np.asarray(m @ d).T))
 
 
@@ -334,6 +339,8 @@ def _graded_levels(
     k: np.ndarray, m: np.ndarray, n_finite: int, q0: np.ndarray | None
 ) -> tuple[np.ndarray, np.ndarray]:
     """The levels of :func:`graded_eigh` (starting in span(q0), default everything)."""
+    import scipy.linalg as sla
+
     n = k.shape[0]
     dm = np.diag(m)
     pos = dm > MASSLESS_TOL * dm.max()
@@ -427,6 +434,8 @@ def _level_rayleigh_ritz(
     level's span (Parlett, *The Symmetric Eigenvalue Problem*, Sec. 11.4).  Otherwise the
     inverse form's shapes are kept.
     """
+    import scipy.linalg as sla
+
     ay = np.abs(y)
     bound = _EPS * np.sum(ay * (np.abs(k) @ ay), axis=0)
     lo = float(np.min(np.abs(lam))) if lam.size else 0.0
@@ -436,7 +445,7 @@ def _level_rayleigh_ritz(
     my = y.T @ m @ y
     try:
         lam_r, v = sla.eigh(0.5 * (ky + ky.T), 0.5 * (my + my.T), check_finite=False)
-    except (sla.LinAlgError, ValueError):
+    except (np.linalg.LinAlgError, ValueError):
         return y, lam
     return y @ v, lam_r
 
@@ -660,13 +669,15 @@ def m_orthonormal_ascending(mass: Any, x: np.ndarray) -> np.ndarray:
     x : ndarray (n, m)
         Linearly independent shapes.
     """
+    import scipy.linalg as sla
+
     if x.shape[1] == 0:
         return x
     g = np.asarray(x.T @ (mass @ x))
     g = 0.5 * (g + g.T)
     try:
         r = sla.cholesky(g, lower=False, check_finite=False)
-    except sla.LinAlgError:
+    except np.linalg.LinAlgError:
         raise SolverError("the computed mode shapes are linearly dependent") from None
     return np.asarray(sla.solve_triangular(r, x.T, trans="T", check_finite=False)).T
 

@@ -9,9 +9,12 @@ use it, and :func:`support_coordinates` picks where to hold a free structure iso
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
-import scipy.linalg as sla
-import scipy.sparse as sp
+
+if TYPE_CHECKING:  # scipy loads on first use: ``import microg.analysis`` stays light
+    import scipy.sparse as sp
 
 __all__ = ["RIGID_TOL", "rigid_basis", "m_orthonormal", "rowwise_small", "support_coordinates"]
 
@@ -92,6 +95,8 @@ def _m_orthonormal_coefficients(gram: np.ndarray, coef: np.ndarray) -> np.ndarra
     for rotations), so that a station's rotary inertia 2e17 kg m^2 beside its mass 3.6e4 kg
     (fuzz reproduction ``model-5a35beda18``) must not make the translations "dependent".
     """
+    import scipy.linalg as sla
+
     g = 0.5 * (gram + gram.T)
     dg = np.diag(g).copy() if g.size else np.zeros(0)
     live = dg > 0.0
@@ -142,6 +147,8 @@ def support_coordinates(basis: np.ndarray) -> np.ndarray:
     ndarray (r,) of int
         Coordinate indices, sorted.
     """
+    import scipy.linalg as sla
+
     r = basis.shape[1]
     if r == 0:
         return np.zeros(0, int)

@@ -79,9 +79,9 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
-import scipy.sparse as sp
 
 from microg.errors import InputError
 from microg.models.graph import ConcentratedMass
@@ -105,6 +105,9 @@ from microg.structure.frame import (
     torsion_is_rigid,
 )
 from microg.structure.structure import PointMap, Structure
+
+if TYPE_CHECKING:  # scipy loads on first use: a figure helper unpickles these classes without it
+    import scipy.sparse as sp
 
 __all__ = [
     "FrameStructure",
@@ -165,6 +168,8 @@ def constrain(
     free : ndarray of int
         Indices of the kept DOFs.
     """
+    import scipy.sparse as sp
+
     keep = np.ones(mass.shape[0], bool)
     keep[np.asarray(fixed_dofs, int)] = False
     free = np.flatnonzero(keep)
@@ -254,6 +259,8 @@ class FrameTree:
 
     def kinematics(self) -> sp.csr_matrix:
         """The unit lower-triangular matrix ``C`` (nodes are numbered parents first)."""
+        import scipy.sparse as sp
+
         n = 6 * self.n_nodes
         t = rigid_link(self.offset)
         rr = 6 * self.child[:, None, None] + np.arange(6)[None, :, None]
@@ -283,6 +290,7 @@ class TreeFlexibility:
     """
 
     def __init__(self, tree: FrameTree) -> None:
+        import scipy.sparse as sp
         import scipy.sparse.linalg as spla
 
         self.tree = tree
@@ -530,6 +538,8 @@ def build_fem(
         stiffness contrast beyond :data:`MAX_STIFFNESS_RATIO`, or a rotation without
         inertia (:func:`check_rotary_inertia`), each naming the parameter or component.
     """
+    import scipy.sparse as sp
+
     if elements_per_beam is not None and (
         int(elements_per_beam) != elements_per_beam or elements_per_beam < 1
     ):

@@ -69,12 +69,9 @@ from __future__ import annotations
 import math
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import scipy.linalg as sla
-import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 from microg.errors import InputError
 from microg.models.graph import (
@@ -89,6 +86,9 @@ from microg.models.graph import (
 )
 from microg.models.station import Beam, RigidBody, Station
 from microg.structure.structure import PointMap, Structure
+
+if TYPE_CHECKING:  # scipy loads on first use (see microg.structure.fem)
+    import scipy.sparse as sp
 
 __all__ = [
     "AXIAL_PENALTY",
@@ -825,6 +825,8 @@ class _PointMaps(Mapping[str, PointMap]):
 def _coo(
     rows: list[np.ndarray], cols: list[np.ndarray], vals: list[np.ndarray], n: int
 ) -> sp.csr_matrix:
+    import scipy.sparse as sp
+
     if not rows:
         return sp.csr_matrix((n, n))
     a = sp.coo_matrix(
@@ -1072,6 +1074,9 @@ def _link_transform(
     graph: GraphModel, P: np.ndarray, index: dict[str, int]
 ) -> tuple[sp.csr_matrix, np.ndarray]:
     """``u_g = T u_ind`` from the rigid links and interpolations (chains resolved exactly)."""
+    import scipy.sparse as sp
+    import scipy.sparse.linalg as spla
+
     n = 6 * P.shape[0]
     eq_rows: list[np.ndarray] = []
     eq_cols: list[np.ndarray] = []
@@ -1160,6 +1165,8 @@ def _link_transform(
 
 def _chain_solve(A: sp.csc_matrix, B: sp.csc_matrix) -> sp.csr_matrix:
     """Sparse solve of (I - G_mm) X = G_mn by repeated substitution (acyclic chains)."""
+    import scipy.sparse as sp
+
     Gmm = sp.identity(A.shape[0], format="csr") - A
     X = sp.csr_matrix(B)
     term = X
@@ -1246,6 +1253,9 @@ def build_frame(
         ``transform`` from the independent set to the 6 DOFs per node (``u_g = transform @
         samples.expand(q)``), the removed and condensed DOF counts and ``warnings``.
     """
+    import scipy.sparse as sp
+    import scipy.sparse.linalg as spla
+
     fm = assemble_frame(graph, mass=mass)
     T = fm.transform
     warnings: list[str] = []
@@ -1447,6 +1457,8 @@ def _mass_basis(
     labels : list of str
         Coordinate labels (new).
     """
+    import scipy.linalg as sla
+    import scipy.sparse as sp
     from scipy.sparse.csgraph import connected_components
 
     n = M.shape[0]
@@ -1539,6 +1551,8 @@ def _samples(
     n_ind: int,
 ) -> FrameSamples:
     """Samples at the connected nodes and at the concentrated masses off their nodes."""
+    import scipy.sparse as sp
+
     live = np.zeros(n_ind, bool)
     live[retained] = True
     live[massless] = True
