@@ -124,23 +124,81 @@ def test_an_unexpected_artist_module_is_left_alone():
 
 LAZY = r"""
 import json, sys, importlib.util
-from microg.cli._startup import install
+from microg.cli._startup import LAZY, install
 install()
 import numpy, scipy.linalg
-lazy = {m: type(sys.modules[m]).__name__ for m in ("numpy.testing", "numpy.f2py")
-        if m in sys.modules}
+lazy = {m: type(sys.modules[m]).__name__ for m in sorted(LAZY) if m in sys.modules}
 ok = numpy.testing.assert_allclose is not None  # loads on first use
+ma = float(numpy.ma.masked_invalid([1.0, numpy.nan]).sum())  # matplotlib's use, in the helpers
 print(json.dumps({"lazy": lazy, "after": type(sys.modules["numpy.testing"]).__name__,
-                  "ok": ok, "unittest": "unittest" in sys.modules}))
+                  "ok": ok, "unittest": "unittest" in sys.modules, "ma": ma,
+                  "ma_after": type(sys.modules["numpy.ma"]).__name__}))
 """
 
 
 def test_numpys_tool_submodules_load_on_first_use():
     out = _py(LAZY)
-    # scipy's array-API clone touched them, and their code has not run
-    assert out["lazy"] == {"numpy.testing": "_LazyModule", "numpy.f2py": "_LazyModule"}
+    # scipy's array-API clone touched them all, and their code has not run
+    from microg.cli._startup import LAZY as lazy_modules
+
+    assert out["lazy"] == dict.fromkeys(sorted(lazy_modules), "_LazyModule")
     assert out["ok"] and out["after"] == "module"  # a real module once used
     assert out["unittest"]  # numpy.testing's own imports ran when it was used
+    assert out["ma"] == 1.0 and out["ma_after"] == "module"  # the masked sum: 1 + (masked)
+
+
+SCIPY_DOCS = r"""
+import json, sys
+if sys.argv[1] == "lean":
+    from microg.cli._startup import install
+    install()
+import numpy as np, scipy.linalg as sla, scipy.sparse as sp
+import scipy._lib._util as util
+a = np.arange(2 * 4 * 4, dtype=float).reshape(2, 4, 4)
+a = a + a.transpose(0, 2, 1) + 40 * np.eye(4)  # a batch of two symmetric matrices
+w = sla.eigh(a, eigvals_only=True)  # through the batch decorator
+print(json.dumps({"scraper": util.FunctionDoc.__name__, "eigh_doc": sla.eigh.__doc__,
+                  "w": w.tolist(), "random_doc": sp.random.__doc__,
+                  "nnz": int(sp.random(6, 6, density=0.5, rng=3).nnz)}))
+"""
+
+
+def _scipy_docs(kind: str) -> dict:
+    proc = subprocess.run(
+        [sys.executable, "-c", SCIPY_DOCS, kind],
+        capture_output=True,
+        text=True,
+        env=_env(),
+        timeout=300,
+        check=True,
+    )
+    return json.loads(proc.stdout.strip().splitlines()[-1])
+
+
+def test_scipys_batch_docstrings_are_not_parsed_and_the_functions_are_the_same():
+    lean, plain = _scipy_docs("lean"), _scipy_docs("plain")
+    assert plain["scraper"] == "FunctionDoc"  # the reference: scipy's own
+    assert lean["scraper"] == "_LeanFunctionDoc"
+    assert lean["w"] == plain["w"]  # the batched call, bit for bit (JSON floats round-trip)
+    assert lean["nnz"] == plain["nnz"]
+    # the docstring as written, with scipy's note on batches appended
+    summary = "Solve a standard or generalized eigenvalue problem"
+    assert summary in lean["eigh_doc"] and summary in plain["eigh_doc"]
+    note = '"batch" dimensions prepended to the core shape'
+    assert note in lean["eigh_doc"] and note in plain["eigh_doc"]
+    # a decorator that reads the parameters (_transition_to_rng) gets the full parse
+    assert lean["random_doc"] == plain["random_doc"]
+
+
+def test_an_unexpected_scipy_util_module_is_left_alone():
+    from types import ModuleType
+
+    from microg.cli._startup import lean_batch_docstrings
+
+    mod = ModuleType("scipy._lib._util")
+    mod.FunctionDoc = object  # no _apply_over_batch: another scipy
+    assert lean_batch_docstrings(mod) is False
+    assert mod.FunctionDoc is object
 
 
 BLAS = r"""

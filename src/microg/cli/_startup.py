@@ -1,4 +1,4 @@
-"""Start-up of the ``microg`` process: one BLAS thread, lazy numpy tools, a leaner matplotlib.
+"""Start-up of the ``microg`` process: one BLAS thread, lazy numpy tools, leaner imports.
 
 **BLAS threads.**  The main job's dense problems are small (the IOC model: 240 DOF), and
 OpenBLAS's second thread only contends with the first, spinning after each call (issue 8:
@@ -9,12 +9,22 @@ them on one thread (before numpy is imported) and sets ``MICROG_BLAS_CORES`` to 
 cores, which :func:`microg.dynamics.dense.blas_threads` gives back to the problems large
 enough to use them (``BLAS_THREADS_MIN_N``).  Child processes inherit both variables.
 
-**Numpy's tool submodules.**  SciPy's bundled ``array_api_compat`` clones numpy's
-namespace when any scipy subpackage is imported, which imports every lazily loaded numpy
-submodule, ``numpy.f2py`` (Fortran wrapping) and ``numpy.testing`` (unittest, ...) among
-them: ~0.08 s of the ~0.25 s scipy.linalg takes to import.  microg uses neither at run time;
-in the ``microg`` process they are created by :class:`importlib.util.LazyLoader`, so their
-code runs only if something reads one of their attributes.
+**Numpy's submodules.**  SciPy's bundled ``array_api_compat`` clones numpy's namespace
+when any scipy subpackage is imported, which imports every lazily loaded numpy submodule,
+``numpy.f2py`` (Fortran wrapping) and ``numpy.testing`` (unittest, ...) among them: ~0.08 s
+of the ~0.25 s scipy.linalg takes to import.  In the ``microg`` process the modules of
+:data:`LAZY` are created by :class:`importlib.util.LazyLoader`, so their code runs only when
+something reads one of their attributes (``numpy.ma``, for one, loads when matplotlib or
+the computation first uses it; a ``microg modes`` run never does).
+
+**SciPy's batch docstrings.**  ``scipy.linalg`` decorates ~70 functions with
+``_apply_over_batch``, which parses each docstring with its numpydoc scraper
+(``FunctionDoc``) at import, to append a note on batched arguments: ~0.03 s of its import
+(scipy 1.15-1.17).  In the ``microg`` process :func:`lean_batch_docstrings` makes that
+scraper parse only when a section other than the extended summary is read (scipy's
+``_transition_to_rng`` reads the parameters, and gets the full parse); otherwise the
+docstring is kept as written, with the note appended.  The decorated functions are the
+same; only their ``__doc__`` text is laid out differently.
 
 **Matplotlib.**
 When matplotlib defines an ``Artist`` subclass, ``Artist.__init_subclass__`` writes the
@@ -28,7 +38,7 @@ works the same, and the figures are the same bytes (``tests/cli/test_cli_startup
 
 Only the command-line process installs these (:func:`microg.cli.main` with ``argv`` None):
 a library caller's BLAS, numpy and matplotlib, in a notebook or a server, are never touched.
-If matplotlib's internals differ from what this expects, nothing is changed.
+If matplotlib's or scipy's internals differ from what this expects, nothing is changed.
 """
 
 from __future__ import annotations
@@ -38,15 +48,36 @@ import importlib.machinery
 import importlib.util
 import os
 import sys
+from collections.abc import Callable
 from types import ModuleType
 from typing import Any
 
-__all__ = ["LAZY", "install", "is_process", "lean_set_docstrings", "one_blas_thread"]
+from microg._fork import usable_cpus
 
-_TARGET = "matplotlib.artist"
+__all__ = [
+    "LAZY",
+    "install",
+    "is_process",
+    "lean_batch_docstrings",
+    "lean_set_docstrings",
+    "one_blas_thread",
+]
 
-#: numpy submodules that the ``microg`` process loads only on first use
-LAZY = frozenset({"numpy.f2py", "numpy.testing"})
+#: numpy submodules that the ``microg`` process loads only on first use (scipy's clone of
+#: numpy's namespace imports them all; it reads ``numpy.fft`` and ``numpy.typing`` itself,
+#: and scipy reads ``numpy.random`` as it imports)
+LAZY = frozenset(
+    {
+        "numpy.char",
+        "numpy.ctypeslib",
+        "numpy.f2py",
+        "numpy.ma",
+        "numpy.polynomial",
+        "numpy.rec",
+        "numpy.strings",
+        "numpy.testing",
+    }
+)
 
 #: environment variables by which a user sets the BLAS thread count
 BLAS_ENV = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS", "BLIS_NUM_THREADS")
@@ -85,11 +116,73 @@ def lean_set_docstrings(artist_module: ModuleType) -> bool:
     return True
 
 
-class _Loader(importlib.abc.Loader):
-    """Runs matplotlib.artist's own loader, then :func:`lean_set_docstrings`."""
+class _LeanFunctionDoc:
+    """Stand-in for scipy's numpydoc scraper ``FunctionDoc`` that parses only on demand.
 
-    def __init__(self, inner: Any) -> None:
+    ``_apply_over_batch`` appends a note to the ``Extended Summary`` and renders the doc
+    (``str``, whose first line it drops): that is answered without parsing, with the
+    docstring as written.  Any other use (``doc["Parameters"]``, item assignment) parses
+    with the real ``FunctionDoc`` first, and from then on everything is the real one's.
+    """
+
+    def __init__(self, func: Any, *args: Any, **kwargs: Any) -> None:
+        self._func, self._args, self._kwargs = func, args, kwargs
+        self._extra: list[str] = []
+        self._real: Any = None
+
+    def _parsed(self) -> Any:
+        if self._real is None:
+            from scipy._lib._docscrape import FunctionDoc
+
+            self._real = FunctionDoc(self._func, *self._args, **self._kwargs)
+            self._real["Extended Summary"].extend(self._extra)
+        return self._real
+
+    def __getitem__(self, key: str) -> Any:
+        if key == "Extended Summary" and self._real is None:
+            return self._extra
+        return self._parsed()[key]
+
+    def __setitem__(self, key: str, value: Any) -> None:
+        self._parsed()[key] = value
+
+    def __str__(self) -> str:
+        if self._real is not None:
+            return str(self._real)
+        doc = (self._func.__doc__ or "").rstrip()
+        note = "\n\n".join(x.strip("\n") for x in self._extra)
+        # the first line stands for the signature, which the callers drop
+        return f"{getattr(self._func, '__name__', '')}(...)\n{doc}\n\n{note}\n"
+
+
+def lean_batch_docstrings(util_module: ModuleType) -> bool:
+    """Make ``scipy._lib._util``'s batch decorator skip parsing docstrings; whether it did.
+
+    Parameters
+    ----------
+    util_module : module
+        ``scipy._lib._util``, already executed.
+    """
+    real = getattr(util_module, "FunctionDoc", None)
+    if real is None or not hasattr(util_module, "_apply_over_batch"):
+        return False  # not the mechanism this expects
+    util_module.FunctionDoc = _LeanFunctionDoc  # type: ignore[attr-defined]
+    return True
+
+
+#: module -> what to do to it right after it executes (in the ``microg`` process)
+_PATCHES: dict[str, Callable[[ModuleType], bool]] = {
+    "matplotlib.artist": lean_set_docstrings,
+    "scipy._lib._util": lean_batch_docstrings,
+}
+
+
+class _Loader(importlib.abc.Loader):
+    """Runs a module's own loader, then its entry of :data:`_PATCHES`."""
+
+    def __init__(self, inner: Any, patch: Callable[[ModuleType], bool]) -> None:
         self._inner = inner
+        self._patch = patch
 
     def create_module(self, spec: importlib.machinery.ModuleSpec) -> ModuleType | None:
         create = getattr(self._inner, "create_module", None)
@@ -97,30 +190,28 @@ class _Loader(importlib.abc.Loader):
 
     def exec_module(self, module: ModuleType) -> None:
         self._inner.exec_module(module)
-        lean_set_docstrings(module)
+        self._patch(module)
 
 
 class _Finder(importlib.abc.MetaPathFinder):
-    """Finds ``matplotlib.artist`` through the other finders and wraps its loader."""
+    """Finds the modules of :data:`_PATCHES` through the path finder and wraps their loaders."""
+
+    def __init__(self, patches: dict[str, Callable[[ModuleType], bool]]) -> None:
+        self._patches = dict(patches)
 
     def find_spec(
         self, fullname: str, path: Any = None, target: ModuleType | None = None
     ) -> importlib.machinery.ModuleSpec | None:
-        if fullname != _TARGET:
+        patch = self._patches.pop(fullname, None)  # once: a module is imported once
+        if patch is None:
             return None
-        sys.meta_path.remove(self)  # once: the module is imported once
+        if not self._patches:
+            sys.meta_path.remove(self)
         spec = importlib.machinery.PathFinder.find_spec(fullname, path)
         if spec is None or spec.loader is None or not hasattr(spec.loader, "exec_module"):
             return spec
-        spec.loader = _Loader(spec.loader)
+        spec.loader = _Loader(spec.loader, patch)
         return spec
-
-
-def _usable_cores() -> int:
-    try:
-        return len(os.sched_getaffinity(0))
-    except (AttributeError, OSError):
-        return os.cpu_count() or 1
 
 
 def one_blas_thread() -> bool:
@@ -131,7 +222,7 @@ def one_blas_thread() -> bool:
     if "numpy" in sys.modules or any(os.environ.get(v) for v in BLAS_ENV):
         return False
     os.environ["OPENBLAS_NUM_THREADS"] = "1"
-    os.environ[CORES_ENV] = str(_usable_cores())
+    os.environ[CORES_ENV] = str(usable_cpus())
     return True
 
 
@@ -157,7 +248,13 @@ def install() -> None:
     one_blas_thread()
     if not any(isinstance(f, _LazyFinder) for f in sys.meta_path):
         sys.meta_path.insert(0, _LazyFinder())
-    if _TARGET in sys.modules:
-        lean_set_docstrings(sys.modules[_TARGET])  # later subclasses only
-    elif not any(isinstance(f, _Finder) for f in sys.meta_path):
-        sys.meta_path.insert(0, _Finder())
+    if any(isinstance(f, _Finder) for f in sys.meta_path):
+        return
+    pending = {}
+    for name, patch in _PATCHES.items():
+        if name in sys.modules:
+            patch(sys.modules[name])  # what comes later only (later subclasses, decorations)
+        else:
+            pending[name] = patch
+    if pending:
+        sys.meta_path.insert(0, _Finder(pending))

@@ -141,6 +141,7 @@ def modes(
     import microg
     from microg._io import dumps
     from microg.cli._errors import flag_errors
+    from microg.cli._load import load_model
     from microg.errors import InputError
     from microg.structure.discretize import discretize
 
@@ -150,7 +151,7 @@ def modes(
         raise InputError("applies to --method ritz only", where="--functions")
     options = {k: v for k, v in (("units", units), ("wtmass", wtmass), ("points", points)) if v}
     with flag_errors(FLAGS):
-        mdl = microg.load_model(model, **options)
+        mdl = load_model(model, method, **options)
         fem_plane = method == "fem" and plane != "3d"
         structure = discretize(
             mdl,

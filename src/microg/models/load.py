@@ -26,7 +26,7 @@ from microg.errors import InputError
 if TYPE_CHECKING:
     from microg.models.modal import ModelOptions
 
-__all__ = ["load_model", "MODEL_SUFFIXES"]
+__all__ = ["load_model", "loads_station", "MODEL_SUFFIXES"]
 
 MODEL_SUFFIXES = (".op2", ".op4", ".unv", ".uff", ".npz", ".toml", ".bdf", ".dat")
 
@@ -47,6 +47,20 @@ def _units(
     from microg.models.modal import parse_units
 
     return parse_units(text, where="units", wtmass=wt)
+
+
+def loads_station(path: str | Path, points: str | Path | None = None) -> bool:
+    """Whether :func:`load_model` reads ``path`` as a station model (TOML, or a shipped name).
+
+    Parameters
+    ----------
+    path : str or Path
+        As for :func:`load_model`.
+    points : str or Path, optional
+        As for :func:`load_model` (a points file makes ``path`` a modal model's).
+    """
+    suffix = Path(path).suffix.lower()
+    return points is None and (suffix == ".toml" or suffix not in MODEL_SUFFIXES)
 
 
 def load_model(
@@ -75,7 +89,7 @@ def load_model(
     p = Path(path)
     suffix = p.suffix.lower()
     label = str(path)
-    if points is None and (suffix == ".toml" or suffix not in MODEL_SUFFIXES):
+    if loads_station(path, points):
         # a station (a file or a shipped name): the modal readers are not needed
         from microg.models.toml import load_station
 
