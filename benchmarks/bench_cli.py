@@ -172,7 +172,8 @@ def _profile_child(out_dir: str, per_figure: bool, helpers: bool) -> dict[str, A
     """One in-process run of what ``microg analyze --json`` does, timed stage by stage.
 
     ``helpers``: the figures are drawn by :func:`microg.report.analysis.start_renderer`'s
-    helper processes, started where the command starts them (before the computation).
+    helper processes, started where the command starts them (before the computation), the
+    model's figures from the moment the modes are solved (as the command does).
     """
     stamps: list[tuple[str, float, float, set[str]]] = []
 
@@ -245,7 +246,9 @@ def _profile_child(out_dir: str, per_figure: bool, helpers: bool) -> dict[str, A
     if per_figure:
         rep.figure_jobs = jobs_timed(rep.figure_jobs)  # type: ignore[assignment]
 
-    result = microg.analyze(progress=mark, command="microg analyze --json")
+    result = microg.analyze(
+        progress=mark, command="microg analyze --json", on_modes=rep.early_figures(renderer)
+    )
     mark("write")
     cli_analyze.write_outputs(result, Path(out_dir), renderer)  # + the JSON --json prints
     mark("end")

@@ -57,6 +57,7 @@ __all__ = [
     "ModeContributions",
     "Observation",
     "Analysis",
+    "ModesReady",
     "analyze",
     "run_analysis",
 ]
@@ -318,6 +319,32 @@ class Observation:
         from microg.plotting.analysis import observation_figure
 
         return observation_figure(self)
+
+
+@dataclass(frozen=True)
+class ModesReady:
+    """The main job part-way: the structure and its modes, before any response.
+
+    What :func:`run_analysis` hands its ``on_modes`` callback as soon as the modes are
+    solved; the same values become the :class:`Analysis`'s fields of these names.
+
+    Attributes
+    ----------
+    model : str
+        Model name.
+    options : AnalysisOptions
+    structure : Structure
+    modes : Modes
+    used : ndarray of bool
+        Modes that enter the response (rigid-body modes and elastic ones up to
+        ``options.max_freq_hz``).
+    """
+
+    model: str
+    options: AnalysisOptions
+    structure: Structure
+    modes: Modes
+    used: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -655,6 +682,7 @@ def analyze(
     sources: Any = None,
     progress: Callable[[str], None] | None = None,
     command: str | None = None,
+    on_modes: Callable[[ModesReady], object] | None = None,
 ) -> Analysis:
     """The main job: modes, response to disturbances, compliance, isolation advice.
 
@@ -705,6 +733,9 @@ def analyze(
         Called with a stage name as each stage starts.
     command : str, optional
         The command line, for the provenance record.
+    on_modes : callable, optional
+        Called with a :class:`ModesReady` as soon as the modes are solved, before the
+        response (``microg analyze`` starts drawing the model's figures then).
 
     Returns
     -------
@@ -784,6 +815,7 @@ def analyze(
         progress=progress,
         requirement=requirement if isinstance(requirement, Requirement) else None,
         command=command,
+        on_modes=on_modes,
     )
 
 
@@ -1161,6 +1193,7 @@ def run_analysis(
     progress: Callable[[str], None] | None = None,
     requirement: Requirement | None = None,
     command: str | None = None,
+    on_modes: Callable[[ModesReady], object] | None = None,
 ) -> Analysis:
     """Run the main job on a model with validated options (see :func:`analyze`).
 
@@ -1174,6 +1207,8 @@ def run_analysis(
         Overrides ``opts.requirement`` (a custom requirement object).
     command : str, optional
         The command line, for the provenance record.
+    on_modes : callable, optional
+        Called with a :class:`ModesReady` once the modes are solved, before the response.
     """
     step = progress or (lambda _s: None)
     _check_record(opts)
@@ -1202,6 +1237,9 @@ def run_analysis(
     warnings: list[str] = []
     elastic = getattr(modes, "elastic", ~modes.rigid)
     used = modes.rigid | (np.asarray(elastic) & (modes.freq_hz <= opts.max_freq_hz))
+    name = str(getattr(model, "name", None) or structure.meta.get("model", "model"))
+    if on_modes is not None:
+        on_modes(ModesReady(name, opts, structure, modes, used))
     observations: dict[str, Observation] = {}
     t = np.zeros(0)
     if opts.disturbances:
@@ -1223,9 +1261,8 @@ def run_analysis(
     for pname, ob in observations.items():
         warnings += [f"{pname}: {w}" for w in ob.assessment.warnings]
     notes = _notes(model, opts, observations)
-    name = getattr(model, "name", None) or structure.meta.get("model", "model")
     return Analysis(
-        model=str(name),
+        model=name,
         options=opts,
         structure=structure,
         modes=modes,

@@ -24,10 +24,20 @@ import microg
 import microg.report.analysis as rep
 from microg.report.render import FigureJob, FigureRenderer
 
+def probe(payload):
+    # what the helper had to import to unpickle an analysis (its sparse matrices omitted)
+    loaded = [m for m in ("scipy", "pydantic", "pint") if m in sys.modules]
+    kinds = sorted({type(payload.structure.mass).__name__, type(payload.modes).__name__})
+    return [FigureJob("probe", 1.0, lambda: json.dumps([loaded, kinds]).encode())]
+
+
 out = {}
+prober = rep.start_renderer(processes=2)  # started before the caller imports scipy, pydantic
 with rep.start_renderer(processes=2) as renderer:  # started before the computation
     out["active"] = renderer.active
-    result = microg.analyze("ioc", observe=["lab"], duration=40, dt=0.02)
+    # the model's figures start once the modes are solved, the rest with the result
+    result = microg.analyze("ioc", observe=["lab"], duration=40, dt=0.02,
+                            on_modes=rep.early_figures(renderer))
     forked = rep.figures(result, renderer)
     out["error"] = renderer.error
 out["parent_loaded_matplotlib"] = "matplotlib" in sys.modules
@@ -45,6 +55,25 @@ def one(payload):
     return [FigureJob("a.png", 1.0, lambda: b"a"), FigureJob("b.png", 1.0, lambda: b"b")]
 
 
+def early(payload):
+    return [FigureJob("a.png", 1.0, lambda: b"early a"), FigureJob("x.png", 1.0, lambda: b"x")]
+
+
+def early_failing(payload):
+    def fail():
+        raise RuntimeError("no early figures")
+    return [FigureJob("a.png", 1.0, fail)]
+
+
+r = FigureRenderer.start((), processes=2)
+r.draw_early(early, 1)
+out["early"] = r.render(one, 1)  # a.png drawn early is not drawn again; x.png is not asked
+r = FigureRenderer.start((), processes=2)
+r.draw_early(early_failing, 1)
+out["early_failing"] = [r.render(one, 1), r.error]  # the final request draws it
+with prober as r:
+    probed = r.render(probe, result, omit=rep._unread)
+    out["probe"] = json.loads(probed["probe"]) if probed else r.error
 r = FigureRenderer.start((), processes=2)
 out["failing"] = [r.render(failing, 1), "no figures today" in (r.error or "")]
 r = FigureRenderer.start((), processes=2)
@@ -75,8 +104,10 @@ try:
     out["children_left"] = True
 except ChildProcessError:
     out["children_left"] = False
-print(json.dumps({k: (v if not isinstance(v, dict) else sorted(v)) for k, v in out.items()},
-                 default=lambda b: b.decode()))
+out["early"] = {k: v.decode() for k, v in out["early"].items()}
+out["early_failing"][0] = {k: v.decode() for k, v in out["early_failing"][0].items()}
+print(json.dumps({k: (v if not isinstance(v, dict) or k.startswith("early") else sorted(v))
+                  for k, v in out.items()}, default=lambda b: b.decode()))
 """
 
 
@@ -93,6 +124,25 @@ def test_helpers_draw_the_same_figures_as_the_caller(forked):
     assert forked["names"][0] == forked["names"][1]  # same files, same (report) order
     assert forked["same_bytes"] and forked["png"]  # reference: in-process drawing, bytewise
     assert not forked["parent_loaded_matplotlib"]  # the caller never imported matplotlib
+
+
+def test_early_figures_are_taken_by_name_and_drawn_once(forked):
+    # a final job named as an early one takes the early figure; early-only names are dropped
+    assert forked["early"] == {"a.png": "early a", "b.png": "b"}
+    # an early drawer that fails costs nothing but time: the final request draws its jobs
+    assert forked["early_failing"] == [{"a.png": "a", "b.png": "b"}, None]
+
+
+def test_the_helper_unpickles_an_analysis_without_scipy(forked):
+    # neither scipy (the structure's sparse matrices are omitted stand-ins) nor pydantic
+    assert forked["probe"] == [[], ["Modes", "Omitted"]]
+
+
+def test_an_omitted_object_says_so_when_read():
+    from microg.report.render import Omitted
+
+    with pytest.raises(AttributeError, match="csr_matrix was omitted .*'toarray'"):
+        Omitted("csr_matrix").toarray()
 
 
 def test_a_failing_helper_means_drawing_in_process(forked):

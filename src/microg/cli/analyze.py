@@ -272,6 +272,7 @@ def analyze(
     reader = {k: v for k, v in (("units", units), ("wtmass", wtmass), ("points", points_file)) if v}
     with flag_errors(FLAGS), contextlib.ExitStack() as stack:
         renderer = stack.enter_context(_renderer())
+        # in-process: the figure helper forked above already has the second core
         mdl = microg.load_model(model, **reader)
         result = microg.analyze(
             mdl,
@@ -286,6 +287,7 @@ def analyze(
             gravity_gradient=gravity_gradient,
             progress=progress,
             command=command,
+            on_modes=_early_figures(renderer),
             **kwargs,
         )
         progress("report")
@@ -313,6 +315,15 @@ def _renderer() -> Any:
     from microg.report.analysis import start_renderer
 
     return start_renderer()
+
+
+def _early_figures(renderer: Any) -> Any:
+    """The helpers start on the model's figures once the modes are solved (none: None)."""
+    if renderer is None:
+        return None
+    from microg.report.analysis import early_figures
+
+    return early_figures(renderer)
 
 
 def _check_out(out_dir: Path) -> None:

@@ -15,7 +15,7 @@ from microg.plotting.common import envelope, finish, new_figure
 from microg.units import G0
 
 if TYPE_CHECKING:
-    from microg.analysis import Analysis, Observation
+    from microg.analysis import Analysis, ModesReady, Observation
     from microg.dynamics.modes import Modes
     from microg.structure.structure import Structure
 
@@ -191,8 +191,14 @@ def force_figure(disturbances: list[Any], duration_s: float) -> Figure:
     return finish(fig)
 
 
-def modes_figure(result: Analysis) -> Figure:
-    """Frequencies of the computed modes, numbered as in the modes table, used ones filled."""
+def modes_figure(result: Analysis | ModesReady) -> Figure:
+    """Frequencies of the computed modes, numbered as in the modes table, used ones filled.
+
+    Parameters
+    ----------
+    result : Analysis or ModesReady
+        Its ``modes``, ``used``, ``options.max_freq_hz`` and ``model`` are drawn.
+    """
     fig = new_figure(7.5, 3.6)
     ax = fig.subplots()
     m = result.modes

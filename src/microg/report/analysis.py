@@ -11,15 +11,18 @@ from typing import TYPE_CHECKING, Any
 from microg._io import to_jsonable
 
 if TYPE_CHECKING:
-    from microg.analysis import Analysis
+    from microg.analysis import Analysis, ModesReady
     from microg.report.render import FigureJob, FigureRenderer
 
 __all__ = [
     "PRELOAD",
+    "UNPICKLE",
+    "early_figures",
     "figure_jobs",
     "figure_names",
     "figures",
     "render_analysis",
+    "setup_jobs",
     "start_renderer",
 ]
 
@@ -45,57 +48,89 @@ _WEIGHTS = {
 }
 
 
-def figure_jobs(result: Analysis) -> list[FigureJob]:
-    """Every figure of the report as a job (file name, cost, how to draw it), in order.
-
-    Nothing is drawn (nor matplotlib imported) until a job's ``draw`` is called.
-    """
+def _job(name: str, kind: str, build: Callable[[], Any]) -> FigureJob:
+    """A figure job drawing ``build()``'s figure to PNG, weighted by its kind."""
     from microg.report.render import FigureJob
 
-    opts = result.options
+    def draw() -> bytes:
+        from microg.plotting.common import png_bytes
+
+        return png_bytes(build())
+
+    return FigureJob(name, _WEIGHTS[kind], draw)
+
+
+def setup_jobs(ready: ModesReady) -> list[FigureJob]:
+    """The figures of the model, its modes and the forces: those known before any response.
+
+    :func:`figure_jobs` begins with these, built from the same values of the result, so a
+    figure drawn from the :class:`~microg.analysis.ModesReady` of a run is the one its
+    result's report shows (the renderer's early figures, :func:`early_figures`).
+    """
+    opts = ready.options
     force_pts = {d.point: d.unit_direction for d in opts.disturbances}
     if opts.sources is not None:
         for s in opts.sources.sources:
             force_pts.setdefault(s.at, s.direction)
-    observed = list(result.observations) or list(opts.observe)
-
-    def job(name: str, kind: str, build: Callable[[], Any]) -> FigureJob:
-        def draw() -> bytes:
-            from microg.plotting.common import png_bytes
-
-            return png_bytes(build())
-
-        return FigureJob(name, _WEIGHTS[kind], draw)
+    observed = list(opts.observe)  # the observations' names, in the same order
 
     def model() -> Any:
         from microg.plotting.analysis import model_figure
 
-        return model_figure(result.structure, result.modes, force_pts, observed)
+        return model_figure(ready.structure, ready.modes, force_pts, observed)
 
     def modes() -> Any:
         from microg.plotting.analysis import modes_figure
 
-        return modes_figure(result)
+        return modes_figure(ready)
 
     def forces() -> Any:
         from microg.plotting.analysis import force_figure
 
         return force_figure(list(opts.disturbances), opts.duration_s)
 
-    jobs = [job("model.png", "model", model), job("modes.png", "modes", modes)]
+    jobs = [_job("model.png", "model", model), _job("modes.png", "modes", modes)]
     if opts.disturbances:
-        jobs.append(job("forces.png", "forces", forces))
+        jobs.append(_job("forces.png", "forces", forces))
+    return jobs
+
+
+def figure_jobs(result: Analysis) -> list[FigureJob]:
+    """Every figure of the report as a job (file name, cost, how to draw it), in order.
+
+    Nothing is drawn (nor matplotlib imported) until a job's ``draw`` is called.
+    """
+    from microg.analysis import ModesReady
+
+    ready = ModesReady(result.model, result.options, result.structure, result.modes, result.used)
+    jobs = setup_jobs(ready)
     stems = figure_names(list(result.observations))
     for name, ob in result.observations.items():
-        jobs += _observation_jobs(job, stems[name], name, ob)
+        jobs += _observation_jobs(_job, stems[name], name, ob)
     fd = result.frequency_domain
     if fd is not None:
         vstems = figure_names(list(fd.points))
         for name in fd.points:
             s = vstems[name]
             for kind, plot in (("vibratory", "bands"), ("sources", "contributions")):
-                jobs.append(job(f"{s}-{kind}.png", kind, partial(fd.plot, name, kind=plot)))
+                jobs.append(_job(f"{s}-{kind}.png", kind, partial(fd.plot, name, kind=plot)))
     return jobs
+
+
+def early_figures(renderer: FigureRenderer | None) -> Callable[[ModesReady], object] | None:
+    """An ``on_modes`` callback for :func:`microg.analyze` that starts the setup figures.
+
+    With a running renderer, the callback sends :func:`setup_jobs` to its helper, which
+    draws them while the response is computed; :func:`figures` then takes them from it.
+    None without a renderer (nothing to start).
+    """
+    if renderer is None or not renderer.active:
+        return None
+
+    def start(ready: ModesReady) -> None:
+        renderer.draw_early(setup_jobs, ready, omit=_unread)
+
+    return start
 
 
 def _observation_jobs(job: Any, s: str, name: str, ob: Any) -> list[FigureJob]:
@@ -181,7 +216,7 @@ def figures(
         done = True
 
     if renderer is not None and renderer.active:
-        out = renderer.render(figure_jobs, result, while_waiting=meanwhile)
+        out = renderer.render(figure_jobs, result, while_waiting=meanwhile, omit=_unread)
         if out is not None:
             return out
     if while_waiting is not None and not done:  # exactly once, on every path
@@ -207,18 +242,26 @@ def _collector_paused() -> Iterator[None]:
             gc.enable()
 
 
-#: what a renderer for :func:`figures` preloads: the figure modules, and the modules an
-#: :class:`~microg.analysis.Analysis` needs to unpickle (its structure's) that a caller
-#: forking before the computation has not imported yet
+#: what a renderer for :func:`figures` imports before its warm-up: the figure modules
 PRELOAD = (
     "microg.plotting.analysis",
     "microg.plotting.environment",
     "microg.report.analysis",
-    "microg.models.graph",
-    "microg.models.toml",
-    "microg.structure.fem",
-    "microg.structure.frame",
 )
+
+#: ... and after it, while it waits: the modules an :class:`~microg.analysis.Analysis` of a
+#: frame model needs to unpickle that a caller forking before its computation has not
+#: imported yet.  None of them loads scipy (its sparse matrices are omitted: :func:`_unread`)
+UNPICKLE = ("microg.structure.fem", "microg.structure.frame")
+
+
+def _unread(obj: object) -> bool:
+    """Whether a figure request omits ``obj``: scipy's sparse matrices, which no figure reads.
+
+    A structure's mass and stiffness matrices; sending them would make the figure helper
+    import scipy (~0.12 s) only to unpickle them.
+    """
+    return type(obj).__module__.startswith("scipy.sparse")
 
 
 def start_renderer(processes: int | None = None) -> FigureRenderer:
@@ -230,7 +273,7 @@ def start_renderer(processes: int | None = None) -> FigureRenderer:
     """
     from microg.report.render import FigureRenderer
 
-    return FigureRenderer.start(PRELOAD, processes)
+    return FigureRenderer.start(PRELOAD, processes, then=UNPICKLE)
 
 
 @lru_cache(maxsize=1)

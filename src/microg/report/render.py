@@ -25,22 +25,21 @@ from __future__ import annotations
 import contextlib
 import gc
 import importlib
+import io
 import os
 import pickle
 import select
-import signal
-import struct
-import sys
 import threading
 import time
 import traceback
-import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from types import TracebackType
 from typing import Any
 
-__all__ = ["FigureJob", "FigureRenderer", "default_processes", "split_jobs"]
+from microg._fork import can_fork, fork, receive, send, stop, usable_cpus, write_all
+
+__all__ = ["FigureJob", "FigureRenderer", "Omitted", "default_processes", "split_jobs"]
 
 #: drawing processes at most (the machine this is tuned for has two cores)
 MAX_PROCESSES = 2
@@ -50,8 +49,6 @@ TIMEOUT_S = 600.0
 
 #: a pickled request larger than this is drawn in-process instead (bytes)
 MAX_PAYLOAD_BYTES = 64_000_000
-
-_HEADER = struct.Struct("<Q")
 
 
 @dataclass(frozen=True)
@@ -75,11 +72,7 @@ def default_processes() -> int:
             return max(1, int(env))
         except ValueError:
             return 1
-    try:
-        cpus = len(os.sched_getaffinity(0))
-    except (AttributeError, OSError):
-        cpus = os.cpu_count() or 1
-    return max(1, min(MAX_PROCESSES, cpus))
+    return max(1, min(MAX_PROCESSES, usable_cpus()))
 
 
 def split_jobs(weights: Sequence[float], parts: int) -> list[list[int]]:
@@ -95,62 +88,6 @@ def split_jobs(weights: Sequence[float], parts: int) -> list[list[int]]:
         groups[g].append(i)
         load[g] += weights[i]
     return [sorted(g) for g in groups if g]
-
-
-# ----------------------------------------------------------------------------- pipes
-
-
-def _send(fd: int, obj: Any) -> None:
-    _write_all(fd, pickle.dumps(obj, protocol=pickle.HIGHEST_PROTOCOL))
-
-
-def _write_all(fd: int, data: bytes) -> None:
-    """``data`` (pickled bytes) written whole, framed by its length."""
-    view = memoryview(_HEADER.pack(len(data)) + data)
-    while view:
-        n = os.write(fd, view)
-        view = view[n:]
-
-
-def _read_exact(fd: int, n: int, deadline: float | None, pid: int | None) -> bytes | None:
-    """``n`` bytes from ``fd``; None at end of file, past the deadline or when ``pid`` died."""
-    chunks = []
-    while n > 0:
-        if deadline is not None:
-            left = deadline - time.monotonic()
-            if left <= 0:
-                return None
-            ready, _, _ = select.select([fd], [], [], min(left, 0.5))
-            if not ready:
-                if pid is not None and _exited(pid):
-                    # the helper died; whatever it wrote is still readable
-                    ready, _, _ = select.select([fd], [], [], 0)
-                    if not ready:
-                        return None
-                else:
-                    continue
-        chunk = os.read(fd, min(n, 1 << 20))
-        if not chunk:
-            return None
-        chunks.append(chunk)
-        n -= len(chunk)
-    return b"".join(chunks)
-
-
-def _receive(fd: int, deadline: float | None = None, pid: int | None = None) -> Any:
-    head = _read_exact(fd, _HEADER.size, deadline, pid)
-    if head is None:
-        return None
-    body = _read_exact(fd, _HEADER.unpack(head)[0], deadline, pid)
-    return None if body is None else pickle.loads(body)
-
-
-def _exited(pid: int) -> bool:
-    try:
-        done, _ = os.waitpid(pid, os.WNOHANG)
-    except ChildProcessError:
-        return True
-    return done == pid
 
 
 # ----------------------------------------------------------------------------- helper side
@@ -173,8 +110,50 @@ def _draw(jobs: Sequence[FigureJob], which: Sequence[int]) -> dict[str, bytes]:
     return {jobs[i].name: jobs[i].draw() for i in which}
 
 
-def _helper(preload: Sequence[str], requests: int, replies: int, processes: int) -> None:
-    """The helper process: load, wait for one request, draw, reply, exit."""
+def _readable(fd: int) -> bool:
+    """Whether ``fd`` has data (or its end of file) to read now."""
+    ready, _, _ = select.select([fd], [], [], 0)
+    return bool(ready)
+
+
+def _fork_drawer(jobs: Sequence[FigureJob], which: Sequence[int]) -> tuple[int, int]:
+    """Fork a process that draws ``jobs[which]`` and sends back their PNGs: (pid, pipe)."""
+    r, w = os.pipe()
+    pid = os.fork()
+    if pid == 0:  # the drawing process
+        code = 0
+        try:
+            os.close(r)
+            send(w, ("ok", _draw(jobs, which)))
+        except BaseException:
+            code = 1
+        finally:
+            os._exit(code)
+    os.close(w)
+    return pid, r
+
+
+def _collect(pid: int, r: int) -> dict[str, bytes] | None:
+    """A drawing process's PNGs (None if it failed), once it has sent them; reaps it."""
+    reply = receive(r, time.monotonic() + TIMEOUT_S, pid)
+    os.close(r)
+    with contextlib.suppress(ChildProcessError):
+        os.waitpid(pid, 0)
+    return dict(reply[1]) if isinstance(reply, tuple) and reply[0] == "ok" else None
+
+
+def _helper(
+    preload: Sequence[str], then: Sequence[str], requests: int, replies: int, processes: int
+) -> None:
+    """The helper process: load, warm up, load more; draw the early request; answer the final.
+
+    Requests are ``(kind, make_jobs, payload)``.  The first ``"early"`` request's jobs are
+    drawn at once by a forked drawing process, while the caller still computes.  The
+    ``"final"`` request is answered with its jobs' figures, each drawn once: a job named as
+    an early one takes the early figure (the caller promises the same figure).  The other
+    final jobs are drawn here (the early drawer still has the second core), or shared with
+    ``processes - 1`` more forks when the early drawer is done or there was none.
+    """
     status = 0
     try:
         # the helper exits by os._exit once it has replied: its objects never need
@@ -185,47 +164,88 @@ def _helper(preload: Sequence[str], requests: int, replies: int, processes: int)
             importlib.import_module(name)
         with contextlib.suppress(Exception):
             _warm_up()
-        request = _receive(requests)
-        if request is None:  # the caller finished without figures
-            return
-        make_jobs, payload = request
-        jobs: list[FigureJob] = make_jobs(payload)
-        groups = split_jobs([j.weight for j in jobs], processes)
-        mine, others = groups[0], groups[1:]
-        children = []
-        for group in others:
-            r, w = os.pipe()
-            pid = os.fork()
-            if pid == 0:  # a second drawing process
-                code = 0
-                try:
-                    os.close(r)
-                    _send(w, ("ok", _draw(jobs, group)))
-                except BaseException:
-                    code = 1
-                finally:
-                    os._exit(code)
-            os.close(w)
-            children.append((pid, r))
-        out = _draw(jobs, mine)
+        for name in then:
+            importlib.import_module(name)
+        early: tuple[int, int] | None = None  # the early drawer: (pid, pipe)
+        early_names: set[str] = set()
+        final: list[FigureJob] | None = None
+        while final is None:
+            request = receive(requests)
+            if request is None:  # the caller finished without (more) figures
+                return
+            kind, make_jobs, payload = request
+            jobs: list[FigureJob] = make_jobs(payload)
+            if kind == "final":
+                final = jobs
+            elif early is None and jobs:
+                early = _fork_drawer(jobs, range(len(jobs)))
+                early_names = {j.name for j in jobs}
+        drawn: dict[str, bytes] = {}
+        if early is not None and _readable(early[1]):  # done already
+            drawn.update(_collect(*early) or {})
+            early = None
+        busy = early_names if early is not None else set()
+        todo = [j for j in final if j.name not in drawn and j.name not in busy]
+        groups = split_jobs([j.weight for j in todo], 1 if early is not None else processes)
+        children = [_fork_drawer(todo, g) for g in groups[1:]]
+        if groups:
+            drawn.update(_draw(todo, groups[0]))
         for pid, r in children:
-            reply = _receive(r, time.monotonic() + TIMEOUT_S, pid)
-            os.close(r)
-            with contextlib.suppress(ChildProcessError):
-                os.waitpid(pid, 0)
-            if not (isinstance(reply, tuple) and reply[0] == "ok"):
+            pngs = _collect(pid, r)
+            if pngs is None:
                 raise RuntimeError("a drawing process failed")
-            out.update(reply[1])
-        _send(replies, ("ok", {j.name: out[j.name] for j in jobs}))
+            drawn.update(pngs)
+        if early is not None:
+            drawn.update(_collect(*early) or {})  # a failed early drawer: drawn here below
+        missing = [j for j in final if j.name not in drawn]
+        drawn.update(_draw(missing, range(len(missing))))
+        send(replies, ("ok", {j.name: drawn[j.name] for j in final}))
     except BaseException:
         status = 1
         with contextlib.suppress(BaseException):
-            _send(replies, ("error", traceback.format_exc()))
+            send(replies, ("error", traceback.format_exc()))
     finally:
         os._exit(status)
 
 
 # ----------------------------------------------------------------------------- caller side
+
+
+class Omitted:
+    """What a helper receives in place of an object its request omits (see ``omit``)."""
+
+    def __init__(self, kind: str) -> None:
+        self.kind = kind
+
+    def __getattr__(self, name: str) -> Any:
+        if name.startswith("__"):
+            raise AttributeError(name)
+        raise AttributeError(f"a {self.kind} was omitted from the figure request ({name!r} read)")
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return (Omitted, (self.kind,))
+
+
+class _OmittingPickler(pickle.Pickler):
+    """A pickler that writes :class:`Omitted` for the objects ``omit`` selects."""
+
+    def __init__(self, file: io.BytesIO, omit: Callable[[object], bool]) -> None:
+        super().__init__(file, protocol=pickle.HIGHEST_PROTOCOL)
+        self._omit = omit
+
+    def reducer_override(self, obj: Any) -> Any:
+        if self._omit(obj):
+            return (Omitted, (type(obj).__name__,))
+        return NotImplemented
+
+
+def _dumps(obj: Any, omit: Callable[[object], bool] | None) -> bytes:
+    """``obj`` pickled, with the objects ``omit`` selects replaced by :class:`Omitted`."""
+    if omit is None:
+        return pickle.dumps(obj, protocol=pickle.HIGHEST_PROTOCOL)
+    buf = io.BytesIO()
+    _OmittingPickler(buf, omit).dump(obj)
+    return buf.getvalue()
 
 
 class FigureRenderer:
@@ -242,6 +262,7 @@ class FigureRenderer:
         self._pid = pid
         self._requests = requests
         self._replies = replies
+        self._sender: threading.Thread | None = None
         self.error: str | None = None  #: why the helper failed, if it did
 
     @property
@@ -250,29 +271,28 @@ class FigureRenderer:
         return self._pid is not None
 
     @classmethod
-    def start(cls, preload: Sequence[str] = (), processes: int | None = None) -> FigureRenderer:
+    def start(
+        cls, preload: Sequence[str] = (), processes: int | None = None, then: Sequence[str] = ()
+    ) -> FigureRenderer:
         """Fork the helper now, which imports ``preload`` (module names) and waits.
 
         Parameters
         ----------
         preload : sequence of str
-            Modules the helper imports while the caller computes.
+            Modules the helper imports while the caller computes, before it warms up.
         processes : int, optional
             Drawing processes (default :func:`default_processes`); 1 starts no helper.
+        then : sequence of str
+            Modules the helper imports after its warm-up (e.g. those the request unpickles
+            with, which the caller imports while it computes).
         """
         n = default_processes() if processes is None else max(1, int(processes))
-        if n < 2 or not hasattr(os, "fork") or threading.active_count() > 1:
+        if n < 2 or not can_fork():
             return cls(None, None, None)  # draw in-process
         req_r, req_w = os.pipe()
         rep_r, rep_w = os.pipe()
-        sys.stdout.flush()
-        sys.stderr.flush()
         try:
-            with warnings.catch_warnings():
-                # Python >= 3.12 warns of fork with threads running: BLAS's idle pool, which
-                # OpenBLAS stops and restarts around a fork itself (pthread_atfork)
-                warnings.simplefilter("ignore", DeprecationWarning)
-                pid = os.fork()
+            pid = fork()
         except OSError:
             for fd in (req_r, req_w, rep_r, rep_w):
                 os.close(fd)
@@ -280,16 +300,79 @@ class FigureRenderer:
         if pid == 0:
             os.close(req_w)
             os.close(rep_r)
-            _helper(preload, req_r, rep_w, n)  # never returns
+            _helper(preload, then, req_r, rep_w, n)  # never returns
         os.close(req_r)
         os.close(rep_w)
         return cls(pid, req_w, rep_r)
+
+    def _post(self, data: bytes) -> None:
+        """Write a request to the helper from a thread, in the order of the requests.
+
+        A helper still importing or drawing reads it later, and the caller goes on.
+        """
+        fd, before = self._requests, self._sender
+        if fd is None:
+            return
+
+        def run() -> None:
+            if before is not None:
+                before.join()
+            with contextlib.suppress(OSError):  # a helper that died: render() sees it
+                write_all(fd, data)
+
+        self._sender = threading.Thread(target=run, name="microg-figure-request", daemon=True)
+        self._sender.start()
+
+    def _request(
+        self, kind: str, make_jobs: Callable[[Any], list[FigureJob]], payload: Any, omit: Any
+    ) -> bool:
+        """Send one request; whether it went (else :attr:`error` says why, when it matters)."""
+        try:
+            data = _dumps((kind, make_jobs, payload), omit)
+        except Exception as exc:  # e.g. a payload that does not pickle
+            self.error = f"{type(exc).__name__}: {exc}"
+            return False
+        if len(data) > MAX_PAYLOAD_BYTES:
+            # a large model's result (issue 11: 193 MB of mode shapes): copying it through
+            # the pipe and unpickling it costs more than drawing here saves
+            self.error = f"the request is {len(data) / 1e6:.0f} MB: drawn in-process"
+            return False
+        self._post(data)
+        return True
+
+    def draw_early(
+        self,
+        make_jobs: Callable[[Any], list[FigureJob]],
+        payload: Any,
+        omit: Callable[[object], bool] | None = None,
+    ) -> bool:
+        """Have the helper draw ``make_jobs(payload)``'s figures now, for :meth:`render`.
+
+        The figures are drawn while the caller goes on; :meth:`render` then answers a job of
+        the same name with the early figure, without drawing it again: a caller sends early
+        only figures that its final jobs would draw the same.
+
+        Parameters
+        ----------
+        make_jobs, payload, omit
+            As for :meth:`render`.
+
+        Returns
+        -------
+        bool
+            Whether the request went (False: no helper, or a payload that does not pickle or
+            is too large; :meth:`render` then draws those figures with the others).
+        """
+        if self._pid is None or self._requests is None:
+            return False
+        return self._request("early", make_jobs, payload, omit)
 
     def render(
         self,
         make_jobs: Callable[[Any], list[FigureJob]],
         payload: Any,
         while_waiting: Callable[[], object] | None = None,
+        omit: Callable[[object], bool] | None = None,
     ) -> dict[str, bytes] | None:
         """The PNG bytes of ``make_jobs(payload)``'s figures, drawn by the helpers.
 
@@ -301,6 +384,11 @@ class FigureRenderer:
             Sent to the helper pickled.
         while_waiting : callable, optional
             Work the caller does while the helpers draw (e.g. loading the HTML template).
+        omit : callable, optional
+            Objects of the payload for which it is true are sent as :class:`Omitted`
+            stand-ins: what no figure reads, and whose classes would cost the helper an
+            import (a structure's sparse matrices: scipy).  A figure that reads one fails,
+            and the figures are drawn in-process instead.
 
         Returns
         -------
@@ -309,29 +397,12 @@ class FigureRenderer:
         """
         if self._pid is None or self._requests is None or self._replies is None:
             return None
-        try:
-            data = pickle.dumps((make_jobs, payload), protocol=pickle.HIGHEST_PROTOCOL)
-        except Exception as exc:  # e.g. a payload that does not pickle
-            self.error = f"{type(exc).__name__}: {exc}"
+        if not self._request("final", make_jobs, payload, omit):
             self.close()
             return None
-        if len(data) > MAX_PAYLOAD_BYTES:
-            # a large model's result (issue 11: 193 MB of mode shapes): copying it through
-            # the pipe and unpickling it costs more than drawing here saves
-            self.error = f"the result is {len(data) / 1e6:.0f} MB: drawn in-process"
-            self.close()
-            return None
-        try:
-            _write_all(self._requests, data)
-        except OSError as exc:
-            self.error = f"{type(exc).__name__}: {exc}"
-            self.close()
-            return None
-        os.close(self._requests)
-        self._requests = None
         if while_waiting is not None:
             while_waiting()
-        reply = _receive(self._replies, time.monotonic() + TIMEOUT_S, self._pid)
+        reply = receive(self._replies, time.monotonic() + TIMEOUT_S, self._pid)
         self.close()
         if isinstance(reply, tuple) and reply[0] == "ok":
             return dict(reply[1])
@@ -340,26 +411,21 @@ class FigureRenderer:
 
     def close(self) -> None:
         """Stop the helper (if it still runs) and release its pipes."""
+        pid, self._pid = self._pid, None
+        if pid is not None:
+            # a helper that replied is exiting; one that never got work is killed at once
+            # (it holds nothing: an error exit must not wait for its imports)
+            stop(pid)
+        sender, self._sender = self._sender, None
+        if sender is not None:
+            # done, or failing now that the helper is gone: its descriptor closes after it
+            sender.join()
         for attr in ("_requests", "_replies"):
             fd = getattr(self, attr)
             if fd is not None:
                 with contextlib.suppress(OSError):
                     os.close(fd)
                 setattr(self, attr, None)
-        pid, self._pid = self._pid, None
-        if pid is None:
-            return
-        # a helper that replied is exiting; one that never got work is killed at once (it
-        # holds nothing: an error exit must not wait for its imports)
-        deadline = time.monotonic() + 0.05
-        while not _exited(pid):
-            if time.monotonic() > deadline:
-                with contextlib.suppress(ProcessLookupError):
-                    os.kill(pid, signal.SIGKILL)
-                with contextlib.suppress(ChildProcessError):
-                    os.waitpid(pid, 0)
-                return
-            time.sleep(0.002)
 
     def __enter__(self) -> FigureRenderer:
         return self
