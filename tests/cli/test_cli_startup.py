@@ -139,9 +139,9 @@ print(json.dumps({"lazy": lazy, "after": type(sys.modules["numpy.testing"]).__na
 def test_numpys_tool_submodules_load_on_first_use():
     out = _py(LAZY)
     # scipy's array-API clone touched them all, and their code has not run
-    from microg.cli._startup import LAZY as lazy_modules
+    import microg.cli._startup as startup
 
-    assert out["lazy"] == dict.fromkeys(sorted(lazy_modules), "_LazyModule")
+    assert out["lazy"] == dict.fromkeys(sorted(startup.LAZY), "_LazyModule")
     assert out["ok"] and out["after"] == "module"  # a real module once used
     assert out["unittest"]  # numpy.testing's own imports ran when it was used
     assert out["ma"] == 1.0 and out["ma_after"] == "module"  # the masked sum: 1 + (masked)
