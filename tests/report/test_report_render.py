@@ -71,6 +71,13 @@ out["early"] = r.render(one, 1)  # a.png drawn early is not drawn again; x.png i
 r = FigureRenderer.start((), processes=2)
 r.draw_early(early_failing, 1)
 out["early_failing"] = [r.render(one, 1), r.error]  # the final request draws it
+with rep.start_renderer(processes=2) as r:  # figures and HTML page written by the helper
+    files = rep.report_files(result, r)
+    out["report_error"] = r.error
+here_files = rep.report_files(result)
+out["report_same"] = [list(files) == list(here_files),
+                      all(files[k] == here_files[k] for k in here_files),
+                      list(files)[-1]]
 with prober as r:
     probed = r.render(probe, result, omit=rep._unread)
     out["probe"] = json.loads(probed["probe"]) if probed else r.error
@@ -131,6 +138,12 @@ def test_early_figures_are_taken_by_name_and_drawn_once(forked):
     assert forked["early"] == {"a.png": "early a", "b.png": "b"}
     # an early drawer that fails costs nothing but time: the final request draws its jobs
     assert forked["early_failing"] == [{"a.png": "a", "b.png": "b"}, None]
+
+
+def test_the_helper_writes_the_same_report_page(forked):
+    # reference: the page and figures made in-process from the same result, byte for byte
+    assert forked["report_error"] is None
+    assert forked["report_same"] == [True, True, "report.html"]
 
 
 def test_the_helper_unpickles_an_analysis_without_scipy(forked):

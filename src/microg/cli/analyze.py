@@ -345,17 +345,16 @@ def write_outputs(result: Any, out_dir: Path, renderer: Any = None) -> tuple[Pat
     which is written while the ``renderer``'s helpers, if any, draw the figures.
     """
     from microg._io import dumps, write_output_files
-    from microg.report.analysis import figures, render_analysis
+    from microg.report.analysis import report_files
 
     box: dict[str, str] = {}
 
-    def json_text() -> None:
-        box["json"] = dumps(result.to_dict())
+    def json_text(summary: dict[str, Any]) -> None:
+        box["json"] = dumps(summary)  # result.to_dict()
 
-    figs = figures(result, renderer, while_waiting=json_text)
-    html = render_analysis(result, figs)
+    report = report_files(result, renderer, while_waiting=json_text)
     text = box["json"]
-    files: dict[str, bytes | str] = {**figs, "report.html": html, "results.json": text}
+    files: dict[str, bytes | str] = {**report, "results.json": text}
     return write_output_files(out_dir, files, where="--out"), text
 
 

@@ -22,6 +22,7 @@ __all__ = [
     "figure_names",
     "figures",
     "render_analysis",
+    "report_files",
     "setup_jobs",
     "start_renderer",
 ]
@@ -225,6 +226,63 @@ def figures(
         return {j.name: j.draw() for j in figure_jobs(result)}
 
 
+def report_files(
+    result: Analysis,
+    renderer: FigureRenderer | None = None,
+    while_waiting: Callable[[dict[str, Any]], object] | None = None,
+) -> dict[str, Any]:
+    """The report's files: every figure's PNG bytes, in report order, then ``report.html``.
+
+    Parameters
+    ----------
+    result : Analysis
+    renderer : FigureRenderer, optional
+        Helper processes started before the computation (:func:`start_renderer`): they
+        draw the figures and write the HTML page while this process runs
+        ``while_waiting``.  Without one, or if it fails, all is done here, as
+        :func:`figures` and :func:`render_analysis` do; the files are the same either way.
+    while_waiting : callable, optional
+        Work of the caller's to do meanwhile, given ``result.to_dict()`` (run once on every
+        path; e.g. writing the JSON text).
+    """
+    summary = result.to_dict()
+    done = False
+
+    def meanwhile() -> None:
+        nonlocal done
+        if while_waiting is not None:
+            while_waiting(summary)
+        done = True
+
+    if renderer is not None and renderer.active:
+        # the page is written by the helper from the caller's summary: a structure's
+        # matrices are not sent (:func:`_unread`), and the summary's effective masses need them
+        out = renderer.render(
+            _report_jobs,
+            (result, summary),
+            while_waiting=meanwhile,
+            omit=_unread,
+            finish=_html_file,
+        )
+        if out is not None and "report.html" in out:
+            return out
+    if while_waiting is not None and not done:  # exactly once, on every path
+        while_waiting(summary)
+    figs = figures(result)
+    return {**figs, "report.html": render_analysis(result, figs, summary)}
+
+
+def _report_jobs(request: tuple[Analysis, dict[str, Any]]) -> list[FigureJob]:
+    """The figure jobs of a :func:`report_files` request (the result, its summary)."""
+    return figure_jobs(request[0])
+
+
+def _html_file(request: tuple[Analysis, dict[str, Any]], figs: dict[str, bytes]) -> dict[str, str]:
+    """``report.html`` of a :func:`report_files` request and its figures (``finish`` step)."""
+    result, summary = request
+    return {"report.html": render_analysis(result, figs, summary)}
+
+
 @contextmanager
 def _collector_paused() -> Iterator[None]:
     """Python's cyclic garbage collector off for the block, back as it was after it.
@@ -267,13 +325,14 @@ def _unread(obj: object) -> bool:
 def start_renderer(processes: int | None = None) -> FigureRenderer:
     """Start the helper processes of :func:`figures` now, before the computation.
 
-    They import matplotlib and the figure modules on another core while the caller
-    computes; pass the renderer to :func:`figures` (use it as a context manager, so the
-    helpers stop if the computation fails).  See :mod:`microg.report.render`.
+    They import matplotlib, the figure modules and the HTML template on another core while
+    the caller computes; pass the renderer to :func:`figures` or :func:`report_files` (use
+    it as a context manager, so the helpers stop if the computation fails).  See
+    :mod:`microg.report.render`.
     """
     from microg.report.render import FigureRenderer
 
-    return FigureRenderer.start(PRELOAD, processes, then=UNPICKLE)
+    return FigureRenderer.start(PRELOAD, processes, then=UNPICKLE, warm=_analysis_template)
 
 
 @lru_cache(maxsize=1)
@@ -284,12 +343,23 @@ def _analysis_template() -> Any:
     return environment().get_template("analyze.html")
 
 
-def render_analysis(result: Analysis, figs: dict[str, bytes]) -> str:
-    """Self-contained HTML of the analysis, figures embedded as data URIs."""
+def render_analysis(
+    result: Analysis, figs: dict[str, bytes], summary: dict[str, Any] | None = None
+) -> str:
+    """Self-contained HTML of the analysis, figures embedded as data URIs.
+
+    Parameters
+    ----------
+    result : Analysis
+    figs : dict of str to bytes
+        PNG bytes by file name (:func:`figures`).
+    summary : dict, optional
+        ``result.to_dict()``, if the caller has it already.
+    """
     from microg import __version__
     from microg.report.html import png_data_uri
 
-    data = to_jsonable(result.to_dict())
+    data = to_jsonable(result.to_dict() if summary is None else summary)
     uris = {k: png_data_uri(v) for k, v in figs.items()}
     stems = figure_names(list(result.observations))
     obs = []

@@ -143,16 +143,22 @@ def _collect(pid: int, r: int) -> dict[str, bytes] | None:
 
 
 def _helper(
-    preload: Sequence[str], then: Sequence[str], requests: int, replies: int, processes: int
+    preload: Sequence[str],
+    then: Sequence[str],
+    warm: Callable[[], object] | None,
+    requests: int,
+    replies: int,
+    processes: int,
 ) -> None:
     """The helper process: load, warm up, load more; draw the early request; answer the final.
 
-    Requests are ``(kind, make_jobs, payload)``.  The first ``"early"`` request's jobs are
+    Requests are ``(kind, make_jobs, payload, finish)``.  The first ``"early"`` request's jobs are
     drawn at once by a forked drawing process, while the caller still computes.  The
     ``"final"`` request is answered with its jobs' figures, each drawn once: a job named as
     an early one takes the early figure (the caller promises the same figure).  The other
     final jobs are drawn here (the early drawer still has the second core), or shared with
-    ``processes - 1`` more forks when the early drawer is done or there was none.
+    ``processes - 1`` more forks when the early drawer is done or there was none.  The final
+    request's ``finish`` (if any) makes more files from its payload and the figures.
     """
     status = 0
     try:
@@ -166,14 +172,22 @@ def _helper(
             _warm_up()
         for name in then:
             importlib.import_module(name)
+        warmed = False
         early: tuple[int, int] | None = None  # the early drawer: (pid, pipe)
         early_names: set[str] = set()
         final: list[FigureJob] | None = None
+        finish: Callable[[Any, dict[str, bytes]], dict[str, str | bytes]] | None = None
         while final is None:
+            if warm is not None and not warmed and not _readable(requests):
+                # no request waiting (or the early drawer just started): the time is free
+                warmed = True
+                with contextlib.suppress(Exception):
+                    warm()
+                continue
             request = receive(requests)
             if request is None:  # the caller finished without (more) figures
                 return
-            kind, make_jobs, payload = request
+            kind, make_jobs, payload, finish = request
             jobs: list[FigureJob] = make_jobs(payload)
             if kind == "final":
                 final = jobs
@@ -199,7 +213,9 @@ def _helper(
             drawn.update(_collect(*early) or {})  # a failed early drawer: drawn here below
         missing = [j for j in final if j.name not in drawn]
         drawn.update(_draw(missing, range(len(missing))))
-        send(replies, ("ok", {j.name: drawn[j.name] for j in final}))
+        pngs = {j.name: drawn[j.name] for j in final}
+        extra = finish(payload, pngs) if finish is not None else {}
+        send(replies, ("ok", pngs, extra))
     except BaseException:
         status = 1
         with contextlib.suppress(BaseException):
@@ -272,7 +288,11 @@ class FigureRenderer:
 
     @classmethod
     def start(
-        cls, preload: Sequence[str] = (), processes: int | None = None, then: Sequence[str] = ()
+        cls,
+        preload: Sequence[str] = (),
+        processes: int | None = None,
+        then: Sequence[str] = (),
+        warm: Callable[[], object] | None = None,
     ) -> FigureRenderer:
         """Fork the helper now, which imports ``preload`` (module names) and waits.
 
@@ -285,6 +305,9 @@ class FigureRenderer:
         then : sequence of str
             Modules the helper imports after its warm-up (e.g. those the request unpickles
             with, which the caller imports while it computes).
+        warm : callable, optional
+            Called in the helper after those imports, when no request waits (e.g. loading
+            a template that a ``finish`` step uses); its errors are ignored.
         """
         n = default_processes() if processes is None else max(1, int(processes))
         if n < 2 or not can_fork():
@@ -300,7 +323,7 @@ class FigureRenderer:
         if pid == 0:
             os.close(req_w)
             os.close(rep_r)
-            _helper(preload, then, req_r, rep_w, n)  # never returns
+            _helper(preload, then, warm, req_r, rep_w, n)  # never returns
         os.close(req_r)
         os.close(rep_w)
         return cls(pid, req_w, rep_r)
@@ -324,11 +347,16 @@ class FigureRenderer:
         self._sender.start()
 
     def _request(
-        self, kind: str, make_jobs: Callable[[Any], list[FigureJob]], payload: Any, omit: Any
+        self,
+        kind: str,
+        make_jobs: Callable[[Any], list[FigureJob]],
+        payload: Any,
+        omit: Any,
+        finish: Any = None,
     ) -> bool:
         """Send one request; whether it went (else :attr:`error` says why, when it matters)."""
         try:
-            data = _dumps((kind, make_jobs, payload), omit)
+            data = _dumps((kind, make_jobs, payload, finish), omit)
         except Exception as exc:  # e.g. a payload that does not pickle
             self.error = f"{type(exc).__name__}: {exc}"
             return False
@@ -373,7 +401,8 @@ class FigureRenderer:
         payload: Any,
         while_waiting: Callable[[], object] | None = None,
         omit: Callable[[object], bool] | None = None,
-    ) -> dict[str, bytes] | None:
+        finish: Callable[[Any, dict[str, bytes]], dict[str, Any]] | None = None,
+    ) -> dict[str, Any] | None:
         """The PNG bytes of ``make_jobs(payload)``'s figures, drawn by the helpers.
 
         Parameters
@@ -389,15 +418,20 @@ class FigureRenderer:
             stand-ins: what no figure reads, and whose classes would cost the helper an
             import (a structure's sparse matrices: scipy).  A figure that reads one fails,
             and the figures are drawn in-process instead.
+        finish : callable, optional
+            A module-level function (pickled by name), called in the helper with the
+            payload and the figures once all are drawn: more files (name -> text or bytes)
+            to return with them (e.g. the HTML page that embeds the figures).
 
         Returns
         -------
         dict of str to bytes, or None
-            None when no helper runs or it failed: the caller then draws in-process.
+            The figures' PNG bytes by name, and the files ``finish`` made; None when no
+            helper runs or it failed: the caller then does it all in-process.
         """
         if self._pid is None or self._requests is None or self._replies is None:
             return None
-        if not self._request("final", make_jobs, payload, omit):
+        if not self._request("final", make_jobs, payload, omit, finish):
             self.close()
             return None
         if while_waiting is not None:
@@ -405,7 +439,7 @@ class FigureRenderer:
         reply = receive(self._replies, time.monotonic() + TIMEOUT_S, self._pid)
         self.close()
         if isinstance(reply, tuple) and reply[0] == "ok":
-            return dict(reply[1])
+            return {**reply[1], **reply[2]}
         self.error = reply[1] if isinstance(reply, tuple) else "the helper process stopped"
         return None
 
