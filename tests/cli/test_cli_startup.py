@@ -237,6 +237,24 @@ def test_the_cores_variable_is_the_one_blas_threads_reads(monkeypatch):
     assert _large() is None
 
 
+SMALL = r"""
+import json, sys
+from microg.cli._startup import install
+install()
+import microg
+from microg.structure.discretize import discretize
+modes = microg.solve_modes(discretize(microg.load_model("ioc")))
+print(json.dumps({"threadpoolctl": "threadpoolctl" in sys.modules, "n": int(modes.n_modes)}))
+"""
+
+
+def test_small_problems_leave_the_one_thread_alone():
+    # the microg process started BLAS on one thread: a small solve changes nothing, so
+    # threadpoolctl is not even imported (the threads were checked above)
+    out = _py(SMALL)
+    assert out["threadpoolctl"] is False and out["n"] > 6
+
+
 def test_a_users_blas_thread_count_is_kept():
     out = _py(BLAS, OPENBLAS_NUM_THREADS="2")
     assert out["cores"] is None  # not set: the user chose

@@ -88,6 +88,11 @@ def _large() -> int | None:
         return None
 
 
+def _started_on_one_thread() -> bool:
+    """Whether this process started OpenBLAS on one thread (:mod:`microg.cli._startup`)."""
+    return _large() is not None and os.environ.get("OPENBLAS_NUM_THREADS") == "1"
+
+
 @contextmanager
 def blas_threads(n: int, threads: int | None = None) -> Iterator[None]:
     """Limit BLAS to one thread (or ``threads``) for a problem of dimension ``n``.
@@ -106,7 +111,9 @@ def blas_threads(n: int, threads: int | None = None) -> Iterator[None]:
     """
     global _CONTROLLER
     want = threads if threads is not None else (1 if n < BLAS_THREADS_MIN_N else _large())
-    if want is None:
+    if want is None or (want == 1 and _CONTROLLER is None and _started_on_one_thread()):
+        # nothing to change: as they are, or still the one thread the process started with
+        # (threadpoolctl's import and library scan, ~10 ms, are spared)
         yield
         return
     try:
