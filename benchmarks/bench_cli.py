@@ -241,6 +241,9 @@ def _profile_child(out_dir: str, per_figure: bool, helpers: bool) -> dict[str, A
 
         return wrapper
 
+    # report_files: the helpers draw the figures and write the page (the caller's wait is
+    # "figures"); in-process, its figures() and render_analysis() are the two stages
+    rep.report_files = staged("figures", rep.report_files)  # type: ignore[assignment]
     rep.figures = staged("figures", rep.figures)  # type: ignore[assignment]
     rep.render_analysis = staged("HTML", rep.render_analysis)  # type: ignore[assignment]
     if per_figure:

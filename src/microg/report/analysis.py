@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import gc
 from collections.abc import Callable, Iterator
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from functools import lru_cache, partial
 from typing import TYPE_CHECKING, Any
 
@@ -129,7 +129,9 @@ def early_figures(renderer: FigureRenderer | None) -> Callable[[ModesReady], obj
         return None
 
     def start(ready: ModesReady) -> None:
-        renderer.draw_early(setup_jobs, ready, omit=_unread)
+        # never the analysis' failure: at worst these figures are drawn with the others
+        with suppress(Exception):
+            renderer.draw_early(setup_jobs, ready, omit=_unread)
 
     return start
 

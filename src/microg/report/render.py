@@ -117,14 +117,23 @@ def _readable(fd: int) -> bool:
 
 
 def _fork_drawer(jobs: Sequence[FigureJob], which: Sequence[int]) -> tuple[int, int]:
-    """Fork a process that draws ``jobs[which]`` and sends back their PNGs: (pid, pipe)."""
+    """Fork a process that draws ``jobs[which]`` and sends back their PNGs: (pid, pipe).
+
+    It stops between figures if the helper has gone (killed with its caller's failure).
+    """
     r, w = os.pipe()
+    parent = os.getpid()
     pid = os.fork()
     if pid == 0:  # the drawing process
         code = 0
         try:
             os.close(r)
-            send(w, ("ok", _draw(jobs, which)))
+            out = {}
+            for i in which:
+                if os.getppid() != parent:  # orphaned: nobody will read the figures
+                    raise SystemExit(1)
+                out[jobs[i].name] = jobs[i].draw()
+            send(w, ("ok", out))
         except BaseException:
             code = 1
         finally:
