@@ -21,7 +21,9 @@ isolation, figures (build and render), HTML, write; each stage lists the heavy l
 loads first.  The stage times add up to the in-process total; the command's own wall time
 adds the interpreter start.  Each profiled process starts as the ``microg`` process does
 (:func:`microg.cli._startup.install`); the serial column draws the figures in-process, the
-helpers column as ``microg analyze`` does (helper processes forked before the model load).
+helpers column as ``microg analyze`` does (a helper forked before the model load draws the
+model's figures once the modes are solved, then the rest and the HTML page: its "figures"
+time is the caller's wait, and "HTML" is then nothing).
 
 Run:  .venv/bin/python benchmarks/bench_cli.py            (about 40 s on the 2-core machine)
       .venv/bin/python benchmarks/bench_cli.py --figures  (also the time of each figure)

@@ -30,7 +30,7 @@ from collections.abc import Callable
 from types import TracebackType
 from typing import Any
 
-__all__ = ["Forked", "can_fork", "receive", "send", "write_all", "exited", "usable_cpus"]
+__all__ = ["Forked", "can_fork", "exited", "pipe", "receive", "send", "usable_cpus", "write_all"]
 
 _HEADER = struct.Struct("<Q")
 
@@ -63,6 +63,23 @@ def fork() -> int:
         # OpenBLAS stops and restarts around a fork itself (pthread_atfork)
         warnings.simplefilter("ignore", DeprecationWarning)
         return os.fork()
+
+
+#: the pipe buffer asked for (Linux ``F_SETPIPE_SZ``; 1 MiB is the default ceiling of
+#: /proc/sys/fs/pipe-max-size): a request of a few MB then goes in a few writes, not ~50
+PIPE_BYTES = 1 << 20
+
+
+def pipe() -> tuple[int, int]:
+    """``os.pipe()``, with a larger buffer where the system allows it (best effort)."""
+    r, w = os.pipe()
+    try:
+        import fcntl
+
+        fcntl.fcntl(w, getattr(fcntl, "F_SETPIPE_SZ", 1031), PIPE_BYTES)
+    except (ImportError, OSError):
+        pass  # the default buffer (64 KiB): slower, the same bytes
+    return r, w
 
 
 def send(fd: int, obj: Any) -> None:
@@ -193,7 +210,7 @@ class Forked:
         """
         if usable_cpus() < 2 or not can_fork():
             return cls(fn, args, kwargs, None, None)
-        r, w = os.pipe()
+        r, w = pipe()
         try:
             pid = fork()
         except OSError:

@@ -37,7 +37,7 @@ from dataclasses import dataclass
 from types import TracebackType
 from typing import Any
 
-from microg._fork import can_fork, fork, receive, send, stop, usable_cpus, write_all
+from microg._fork import can_fork, fork, pipe, receive, send, stop, usable_cpus, write_all
 
 __all__ = ["FigureJob", "FigureRenderer", "Omitted", "default_processes", "split_jobs"]
 
@@ -121,7 +121,7 @@ def _fork_drawer(jobs: Sequence[FigureJob], which: Sequence[int]) -> tuple[int, 
 
     It stops between figures if the helper has gone (killed with its caller's failure).
     """
-    r, w = os.pipe()
+    r, w = pipe()
     parent = os.getpid()
     pid = os.fork()
     if pid == 0:  # the drawing process
@@ -321,8 +321,8 @@ class FigureRenderer:
         n = default_processes() if processes is None else max(1, int(processes))
         if n < 2 or not can_fork():
             return cls(None, None, None)  # draw in-process
-        req_r, req_w = os.pipe()
-        rep_r, rep_w = os.pipe()
+        req_r, req_w = pipe()
+        rep_r, rep_w = pipe()
         try:
             pid = fork()
         except OSError:
