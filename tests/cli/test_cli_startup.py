@@ -235,6 +235,10 @@ def test_the_cores_variable_is_the_one_blas_threads_reads(monkeypatch):
     assert _large() == 3  # the name _startup sets is the name dense reads
     monkeypatch.delenv(CORES_ENV)
     assert _large() is None
+    from microg.cli._startup import ONE_THREAD_ENV
+    from microg.dynamics.dense import _ONE_THREAD_ENV
+
+    assert ONE_THREAD_ENV == _ONE_THREAD_ENV  # what _startup sets is what dense trusts
 
 
 SMALL = r"""
@@ -244,15 +248,48 @@ install()
 import microg
 from microg.structure.discretize import discretize
 modes = microg.solve_modes(discretize(microg.load_model("ioc")))
-print(json.dumps({"threadpoolctl": "threadpoolctl" in sys.modules, "n": int(modes.n_modes)}))
+loaded = "threadpoolctl" in sys.modules
+from threadpoolctl import threadpool_info
+threads = sorted({i["num_threads"] for i in threadpool_info() if i["user_api"] == "blas"})
+print(json.dumps({"threadpoolctl": loaded, "n": int(modes.n_modes), "threads": threads}))
 """
 
 
 def test_small_problems_leave_the_one_thread_alone():
     # the microg process started BLAS on one thread: a small solve changes nothing, so
-    # threadpoolctl is not even imported (the threads were checked above)
+    # threadpoolctl is not even imported during it, and the BLAS still runs on one thread
     out = _py(SMALL)
     assert out["threadpoolctl"] is False and out["n"] > 6
+    assert out["threads"] == [1]
+
+
+def test_the_figure_helper_forks_before_the_progress_bar(monkeypatch, tmp_path):
+    # a visible bar starts tqdm's monitor thread, and the renderer does not fork a process
+    # with threads: the helper must start first (review of issue 8's helpers)
+    import contextlib
+
+    import microg.cli._startup as startup
+    import microg.cli.analyze as cli_analyze
+
+    order: list[str] = []
+
+    class StopError(Exception):
+        pass
+
+    def renderer() -> contextlib.AbstractContextManager:
+        order.append("renderer")
+        return contextlib.nullcontext(None)
+
+    def bar(*args, **kwargs):
+        order.append("bar")
+        raise StopError
+
+    monkeypatch.setattr(startup, "is_process", lambda: True)
+    monkeypatch.setattr(cli_analyze, "_renderer", renderer)
+    monkeypatch.setattr("microg.cli._progress.progress_bar", bar)
+    with contextlib.suppress(StopError):
+        cli_analyze.analyze.main(["--out", str(tmp_path / "o")], standalone_mode=False)
+    assert order == ["renderer", "bar"]
 
 
 def test_a_users_blas_thread_count_is_kept():

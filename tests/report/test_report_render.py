@@ -19,7 +19,7 @@ from hypothesis import strategies as st
 from microg.report.render import FigureRenderer, default_processes, split_jobs
 
 SCRIPT = r"""
-import json, os, sys
+import json, os, sys, time
 import microg
 import microg.report.analysis as rep
 from microg.report.render import FigureJob, FigureRenderer
@@ -40,6 +40,7 @@ with rep.start_renderer(processes=2) as renderer:  # started before the computat
                             on_modes=rep.early_figures(renderer))
     forked = rep.figures(result, renderer)
     out["error"] = renderer.error
+    out["early_used"] = renderer.early_used
 out["parent_loaded_matplotlib"] = "matplotlib" in sys.modules
 here = rep.figures(result)
 out["names"] = [list(forked), list(here)]
@@ -67,20 +68,75 @@ def early_failing(payload):
 
 r = FigureRenderer.start((), processes=2)
 r.draw_early(early, 1)
-out["early"] = r.render(one, 1)  # a.png drawn early is not drawn again; x.png is not asked
+out["early"] = r.render(one, 1, reuse_early=True)  # a.png drawn early, x.png not asked
 r = FigureRenderer.start((), processes=2)
 r.draw_early(early_failing, 1)
-out["early_failing"] = [r.render(one, 1), r.error]  # the final request draws it
-with rep.start_renderer(processes=2) as r:  # figures and HTML page written by the helper
-    files = rep.report_files(result, r)
-    out["report_error"] = r.error
-here_files = rep.report_files(result)
+out["early_failing"] = [r.render(one, 1, reuse_early=True), r.error]  # the final draws it
+with rep.start_renderer(processes=2) as r:  # as microg analyze: early figures, then the page
+    second = microg.analyze("ioc", observe=["lab"], duration=40, dt=0.02,
+                            on_modes=rep.early_figures(r))
+    files = rep.report_files(second, r)
+    out["report_error"] = [r.error, r.early_used]
+here_files = rep.report_files(second)
 out["report_same"] = [list(files) == list(here_files),
                       all(files[k] == here_files[k] for k in here_files),
                       list(files)[-1]]
+with rep.start_renderer(processes=2) as r:  # the early request of another analysis
+    first = microg.analyze("ioc", observe=["lab"], duration=40, dt=0.02,
+                           on_modes=rep.early_figures(r))
+    other = microg.analyze("ioc", observe=["lab"], duration=40, dt=0.02, max_freq=2.0)
+    stale = rep.figures(other, r)
+    out["stale"] = [r.error, r.early_used, r.draw_early(rep.setup_jobs, first)]
+fresh = rep.figures(other)
+out["stale_same"] = [sorted(stale) == sorted(fresh), all(stale[k] == fresh[k] for k in fresh),
+                     stale["modes.png"] != rep.figures(first)["modes.png"]]
 with prober as r:
-    probed = r.render(probe, result, omit=rep._unread)
+    probed = r.render(probe, result, omit=rep._unread(result.structure))
     out["probe"] = json.loads(probed["probe"]) if probed else r.error
+
+
+def slow(payload):
+    return [FigureJob("slow.png", 1.0, lambda: time.sleep(30) or b"late")]
+
+
+def children_of(pid):
+    kids = []
+    for d in os.listdir("/proc"):
+        if d.isdigit():
+            try:
+                with open(f"/proc/{d}/stat") as f:
+                    state, ppid = f.read().rsplit(")", 1)[1].split()[:2]
+            except OSError:
+                continue
+            if int(ppid) == pid and state != "Z":
+                kids.append(int(d))
+    return kids
+
+
+def alive(pid):
+    try:
+        with open(f"/proc/{pid}/stat") as f:
+            return f.read().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
+        return False
+
+
+import time
+r = FigureRenderer.start((), processes=2)
+r.draw_early(slow, 1)  # the early drawer sleeps in its figure; then the caller fails
+deadline, kids = time.monotonic() + 10, []
+while not kids and time.monotonic() < deadline:
+    time.sleep(0.01)
+    kids = children_of(r._pid)
+r.close()
+time.sleep(0.2)
+out["orphans"] = [len(kids), [k for k in kids if alive(k)]]
+import microg.report.render as render_module
+limit = render_module.MAX_PAYLOAD_BYTES
+render_module.MAX_PAYLOAD_BYTES = 1000
+r = FigureRenderer.start((), processes=2)
+out["large_early"] = [r.draw_early(one, b"x" * 2000), r.render(one, 1), "MB" in (r.error or "")]
+render_module.MAX_PAYLOAD_BYTES = limit
 r = FigureRenderer.start((), processes=2)
 out["failing"] = [r.render(failing, 1), "no figures today" in (r.error or "")]
 r = FigureRenderer.start((), processes=2)
@@ -141,9 +197,29 @@ def test_early_figures_are_taken_by_name_and_drawn_once(forked):
 
 
 def test_the_helper_writes_the_same_report_page(forked):
-    # reference: the page and figures made in-process from the same result, byte for byte
-    assert forked["report_error"] is None
+    # reference: the page and figures made in-process from the same result, byte for byte,
+    # on microg analyze's path: the setup figures taken from the early request
+    setup = ["forces.png", "model.png", "modes.png"]
+    assert forked["report_error"] == [None, setup]
     assert forked["report_same"] == [True, True, "report.html"]
+    assert forked["early_used"] == setup and forked["error"] is None
+
+
+def test_early_figures_of_another_analysis_are_not_used(forked):
+    # an early request made from another run's modes: everything is drawn again, and the
+    # files are the in-process ones of the result asked for (its modes.png differs)
+    assert forked["stale"] == [None, [], False]  # and one early request per renderer
+    assert forked["stale_same"] == [True, True, True]
+
+
+def test_no_drawing_process_outlives_its_helper(forked):
+    n, left = forked["orphans"]
+    assert n == 1 and left == []  # the early drawer existed, and died with the helper
+
+
+def test_a_large_early_request_is_refused_once(forked):
+    # refused for its size; the final request is then not even tried (drawn in-process)
+    assert forked["large_early"] == [False, None, True]
 
 
 def test_the_helper_unpickles_an_analysis_without_scipy(forked):

@@ -5,9 +5,10 @@ OpenBLAS's second thread only contends with the first, spinning after each call 
 "a 240x240 Cholesky takes 0.3 ms on 1 thread and 148 ms on 2"); numpy and scipy each load
 their own OpenBLAS.  Unless the user set a BLAS thread count (``OPENBLAS_NUM_THREADS``,
 ``OMP_NUM_THREADS``, ``MKL_NUM_THREADS``, ``BLIS_NUM_THREADS``), :func:`install` starts
-them on one thread (before numpy is imported) and sets ``MICROG_BLAS_CORES`` to the usable
-cores, which :func:`microg.dynamics.dense.blas_threads` gives back to the problems large
-enough to use them (``BLAS_THREADS_MIN_N``).  Child processes inherit both variables.
+them on one thread before numpy is imported (:data:`ONE_THREAD_ENV`: OpenBLAS, MKL or BLIS)
+and sets ``MICROG_BLAS_CORES`` to the usable cores, which
+:func:`microg.dynamics.dense.blas_threads` gives back to the problems large enough to use
+them (``BLAS_THREADS_MIN_N``).  Child processes inherit these variables.
 
 **Numpy's submodules.**  SciPy's bundled ``array_api_compat`` clones numpy's namespace
 when any scipy subpackage is imported, which imports every lazily loaded numpy submodule,
@@ -56,6 +57,7 @@ from microg._fork import usable_cpus
 
 __all__ = [
     "LAZY",
+    "ONE_THREAD_ENV",
     "install",
     "is_process",
     "lean_batch_docstrings",
@@ -81,6 +83,9 @@ LAZY = frozenset(
 
 #: environment variables by which a user sets the BLAS thread count
 BLAS_ENV = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS", "BLIS_NUM_THREADS")
+#: what :func:`one_blas_thread` sets to 1 (not ``OMP_NUM_THREADS``, which other OpenMP code
+#: reads too); ``dense._started_on_one_thread`` reads the same names
+ONE_THREAD_ENV = ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "BLIS_NUM_THREADS")
 #: the usable cores, for the problems that use them; ``dense._large`` reads the same name
 #: (this module runs before numpy loads, so it cannot import ``microg.dynamics.dense``)
 CORES_ENV = "MICROG_BLAS_CORES"
@@ -221,7 +226,8 @@ def one_blas_thread() -> bool:
     """
     if "numpy" in sys.modules or any(os.environ.get(v) for v in BLAS_ENV):
         return False
-    os.environ["OPENBLAS_NUM_THREADS"] = "1"
+    for name in ONE_THREAD_ENV:  # whichever BLAS numpy and scipy were built with
+        os.environ[name] = "1"
     os.environ[CORES_ENV] = str(usable_cpus())
     return True
 

@@ -261,17 +261,19 @@ def analyze(
     if package_mass is not None:
         kwargs["package_mass"] = package_mass
     stages = ["structure", "modes", "response", "assessment", "isolation", "report"]
-    bar = progress_bar(len(stages), "microg analyze", hide=no_progress)
-
-    def progress(stage: str) -> None:
-        bar.set_postfix_str(stage)
-        if stage != "structure":
-            bar.update(1)
-
     command = "microg " + " ".join(shlex.quote(a) for a in sys.argv[1:])
     reader = {k: v for k, v in (("units", units), ("wtmass", wtmass), ("points", points_file)) if v}
     with flag_errors(FLAGS), contextlib.ExitStack() as stack:
+        # the figure helper forks first: a visible progress bar runs a monitor thread, and a
+        # process with threads does not fork (microg.report.render)
         renderer = stack.enter_context(_renderer())
+        bar = progress_bar(len(stages), "microg analyze", hide=no_progress)
+
+        def progress(stage: str) -> None:
+            bar.set_postfix_str(stage)
+            if stage != "structure":
+                bar.update(1)
+
         # in-process: the figure helper forked above already has the second core
         mdl = microg.load_model(model, **reader)
         result = microg.analyze(

@@ -88,9 +88,14 @@ def _large() -> int | None:
         return None
 
 
+#: the variables by which :mod:`microg.cli._startup` starts BLAS on one thread (its
+#: ``ONE_THREAD_ENV``: that module runs before numpy loads, so it cannot import this one)
+_ONE_THREAD_ENV = ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "BLIS_NUM_THREADS")
+
+
 def _started_on_one_thread() -> bool:
-    """Whether this process started OpenBLAS on one thread (:mod:`microg.cli._startup`)."""
-    return _large() is not None and os.environ.get("OPENBLAS_NUM_THREADS") == "1"
+    """Whether this process started its BLAS on one thread (:mod:`microg.cli._startup`)."""
+    return _large() is not None and all(os.environ.get(v) == "1" for v in _ONE_THREAD_ENV)
 
 
 @contextmanager

@@ -73,7 +73,7 @@ def setup_jobs(ready: ModesReady) -> list[FigureJob]:
     if opts.sources is not None:
         for s in opts.sources.sources:
             force_pts.setdefault(s.at, s.direction)
-    observed = list(opts.observe)  # the observations' names, in the same order
+    observed = list(dict.fromkeys(opts.observe))  # the observations' names, in order
 
     def model() -> Any:
         from microg.plotting.analysis import model_figure
@@ -131,7 +131,7 @@ def early_figures(renderer: FigureRenderer | None) -> Callable[[ModesReady], obj
     def start(ready: ModesReady) -> None:
         # never the analysis' failure: at worst these figures are drawn with the others
         with suppress(Exception):
-            renderer.draw_early(setup_jobs, ready, omit=_unread)
+            renderer.draw_early(setup_jobs, ready, omit=_unread(ready.structure))
 
     return start
 
@@ -219,7 +219,13 @@ def figures(
         done = True
 
     if renderer is not None and renderer.active:
-        out = renderer.render(figure_jobs, result, while_waiting=meanwhile, omit=_unread)
+        out = renderer.render(
+            figure_jobs,
+            result,
+            while_waiting=meanwhile,
+            omit=_unread(result.structure),
+            reuse_early=_same_setup(renderer.early_payload, result),
+        )
         if out is not None:
             return out
     if while_waiting is not None and not done:  # exactly once, on every path
@@ -263,8 +269,9 @@ def report_files(
             _report_jobs,
             (result, summary),
             while_waiting=meanwhile,
-            omit=_unread,
+            omit=_unread(result.structure),
             finish=_html_file,
+            reuse_early=_same_setup(renderer.early_payload, result),
         )
         if out is not None and "report.html" in out:
             return out
@@ -311,17 +318,31 @@ PRELOAD = (
 
 #: ... and after it, while it waits: the modules an :class:`~microg.analysis.Analysis` of a
 #: frame model needs to unpickle that a caller forking before its computation has not
-#: imported yet.  None of them loads scipy (its sparse matrices are omitted: :func:`_unread`)
+#: imported yet.  None of them loads scipy (the matrices are omitted: :func:`_unread`)
 UNPICKLE = ("microg.structure.fem", "microg.structure.frame")
 
 
-def _unread(obj: object) -> bool:
-    """Whether a figure request omits ``obj``: scipy's sparse matrices, which no figure reads.
+def _unread(structure: Any) -> Callable[[object], bool]:
+    """What a figure request omits: the structure's mass and stiffness matrices.
 
-    A structure's mass and stiffness matrices; sending them would make the figure helper
-    import scipy (~0.12 s) only to unpickle them.
+    No figure reads them, and sending them (scipy sparse matrices) would make the figure
+    helper import scipy (~0.12 s) only to unpickle them.  The objects themselves, by
+    identity: other sparse matrices (a frame model's sample rows) are sent.
     """
-    return type(obj).__module__.startswith("scipy.sparse")
+    ids = {id(structure.mass), id(structure.stiffness)}
+    return lambda obj: id(obj) in ids
+
+
+def _same_setup(ready: Any, result: Analysis) -> bool:
+    """Whether an early request's :class:`~microg.analysis.ModesReady` is ``result``'s own.
+
+    Only then do the early figures stand for the result's (the same objects, not merely
+    equal ones: a renderer reused for another analysis draws everything again).
+    """
+    if ready is None:
+        return False
+    same = all(getattr(ready, k) is getattr(result, k) for k in ("options", "structure", "modes"))
+    return same and ready.used is result.used and ready.model == result.model
 
 
 def start_renderer(processes: int | None = None) -> FigureRenderer:

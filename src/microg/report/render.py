@@ -29,6 +29,7 @@ import io
 import os
 import pickle
 import select
+import signal
 import threading
 import time
 import traceback
@@ -49,6 +50,9 @@ TIMEOUT_S = 600.0
 
 #: a pickled request larger than this is drawn in-process instead (bytes)
 MAX_PAYLOAD_BYTES = 64_000_000
+
+#: Linux prctl option: the signal a process gets when its parent exits
+_PR_SET_PDEATHSIG = 1
 
 
 @dataclass(frozen=True)
@@ -116,18 +120,29 @@ def _readable(fd: int) -> bool:
     return bool(ready)
 
 
+def _die_with(parent: int) -> None:
+    """Have the kernel kill this process when ``parent`` goes (Linux); exit if it has gone."""
+    with contextlib.suppress(Exception):
+        import ctypes
+
+        ctypes.CDLL(None, use_errno=True).prctl(_PR_SET_PDEATHSIG, signal.SIGKILL)
+    if os.getppid() != parent:
+        os._exit(1)
+
+
 def _fork_drawer(jobs: Sequence[FigureJob], which: Sequence[int]) -> tuple[int, int]:
     """Fork a process that draws ``jobs[which]`` and sends back their PNGs: (pid, pipe).
 
-    It stops between figures if the helper has gone (killed with its caller's failure).
+    It dies with the helper (killed when its caller fails): nothing is left drawing.
     """
     r, w = pipe()
     parent = os.getpid()
-    pid = os.fork()
+    pid = fork()
     if pid == 0:  # the drawing process
         code = 0
         try:
             os.close(r)
+            _die_with(parent)
             out = {}
             for i in which:
                 if os.getppid() != parent:  # orphaned: nobody will read the figures
@@ -140,6 +155,15 @@ def _fork_drawer(jobs: Sequence[FigureJob], which: Sequence[int]) -> tuple[int, 
             os._exit(code)
     os.close(w)
     return pid, r
+
+
+def _discard(pid: int, r: int) -> None:
+    """Stop a drawing process whose figures are not wanted, and reap it."""
+    with contextlib.suppress(ProcessLookupError):
+        os.kill(pid, signal.SIGKILL)
+    os.close(r)
+    with contextlib.suppress(ChildProcessError):
+        os.waitpid(pid, 0)
 
 
 def _collect(pid: int, r: int) -> dict[str, bytes] | None:
@@ -161,13 +185,16 @@ def _helper(
 ) -> None:
     """The helper process: load, warm up, load more; draw the early request; answer the final.
 
-    Requests are ``(kind, make_jobs, payload, finish)``.  The first ``"early"`` request's jobs are
-    drawn at once by a forked drawing process, while the caller still computes.  The
-    ``"final"`` request is answered with its jobs' figures, each drawn once: a job named as
-    an early one takes the early figure (the caller promises the same figure).  The other
-    final jobs are drawn here (the early drawer still has the second core), or shared with
-    ``processes - 1`` more forks when the early drawer is done or there was none.  The final
-    request's ``finish`` (if any) makes more files from its payload and the figures.
+    Requests are ``(kind, make_jobs, payload, finish, reuse)``.  The first ``"early"``
+    request's jobs are drawn at once by a forked drawing process, while the caller still
+    computes (one whose jobs cannot be made is ignored: the final one draws them).  The
+    ``"final"`` request is answered with its jobs' figures, each drawn once: with ``reuse``,
+    a job named as an early one takes the early figure (the caller has checked that the
+    early request was made from the same values); without, the early drawer is stopped.
+    The other final jobs are drawn here (the early drawer still has the second core), or
+    shared with ``processes - 1`` more forks when the early drawer is done or there was
+    none.  The final request's ``finish`` (if any) makes more files from its payload and the
+    figures.  The reply names the figures taken from the early request.
     """
     status = 0
     try:
@@ -185,7 +212,6 @@ def _helper(
         early: tuple[int, int] | None = None  # the early drawer: (pid, pipe)
         early_names: set[str] = set()
         final: list[FigureJob] | None = None
-        finish: Callable[[Any, dict[str, bytes]], dict[str, str | bytes]] | None = None
         while final is None:
             if warm is not None and not warmed and not _readable(requests):
                 # no request waiting (or the early drawer just started): the time is free
@@ -196,17 +222,23 @@ def _helper(
             request = receive(requests)
             if request is None:  # the caller finished without (more) figures
                 return
-            kind, make_jobs, payload, finish = request
-            jobs: list[FigureJob] = make_jobs(payload)
+            kind, make_jobs, payload, finish, reuse = request
             if kind == "final":
-                final = jobs
-            elif early is None and jobs:
-                early = _fork_drawer(jobs, range(len(jobs)))
-                early_names = {j.name for j in jobs}
+                final = make_jobs(payload)
+            elif early is None:
+                with contextlib.suppress(Exception):
+                    jobs: list[FigureJob] = make_jobs(payload)
+                    if jobs:
+                        early = _fork_drawer(jobs, range(len(jobs)))
+                        early_names = {j.name for j in jobs}
+        if early is not None and not reuse:
+            _discard(*early)
+            early, early_names = None, set()
         drawn: dict[str, bytes] = {}
         if early is not None and _readable(early[1]):  # done already
             drawn.update(_collect(*early) or {})
             early = None
+        taken = set(drawn)
         busy = early_names if early is not None else set()
         todo = [j for j in final if j.name not in drawn and j.name not in busy]
         groups = split_jobs([j.weight for j in todo], 1 if early is not None else processes)
@@ -219,12 +251,14 @@ def _helper(
                 raise RuntimeError("a drawing process failed")
             drawn.update(pngs)
         if early is not None:
-            drawn.update(_collect(*early) or {})  # a failed early drawer: drawn here below
+            late = _collect(*early) or {}  # a failed early drawer: drawn here below
+            drawn.update({k: v for k, v in late.items() if k not in drawn})
+            taken |= set(late)
         missing = [j for j in final if j.name not in drawn]
         drawn.update(_draw(missing, range(len(missing))))
         pngs = {j.name: drawn[j.name] for j in final}
         extra = finish(payload, pngs) if finish is not None else {}
-        send(replies, ("ok", pngs, extra))
+        send(replies, ("ok", pngs, extra, sorted(taken & set(pngs))))
     except BaseException:
         status = 1
         with contextlib.suppress(BaseException):
@@ -254,14 +288,32 @@ class Omitted:
 class _OmittingPickler(pickle.Pickler):
     """A pickler that writes :class:`Omitted` for the objects ``omit`` selects."""
 
-    def __init__(self, file: io.BytesIO, omit: Callable[[object], bool]) -> None:
-        super().__init__(file, protocol=pickle.HIGHEST_PROTOCOL)
+    def __init__(
+        self,
+        file: io.BytesIO,
+        omit: Callable[[object], bool],
+        buffer_callback: Callable[[pickle.PickleBuffer], object] | None = None,
+    ) -> None:
+        super().__init__(file, protocol=5, buffer_callback=buffer_callback)
         self._omit = omit
 
     def reducer_override(self, obj: Any) -> Any:
         if self._omit(obj):
             return (Omitted, (type(obj).__name__,))
         return NotImplemented
+
+
+def _pickled_size(obj: Any, omit: Callable[[object], bool] | None) -> int:
+    """The bytes ``_dumps(obj, omit)`` would make, counted without copying large arrays.
+
+    Protocol 5 hands contiguous buffers (numpy arrays) to a callback instead of copying
+    them: a 193-MB result is measured in milliseconds, not pickled to be refused.
+    """
+    buffers: list[pickle.PickleBuffer] = []
+    buf = io.BytesIO()
+    pickler = _OmittingPickler(buf, omit or (lambda _o: False), buffers.append)
+    pickler.dump(obj)
+    return buf.tell() + sum(b.raw().nbytes for b in buffers)
 
 
 def _dumps(obj: Any, omit: Callable[[object], bool] | None) -> bytes:
@@ -288,6 +340,9 @@ class FigureRenderer:
         self._requests = requests
         self._replies = replies
         self._sender: threading.Thread | None = None
+        self._too_large = False  # a request was refused for its size: so would the next
+        self.early_payload: Any = None  #: the payload of the early request sent, if any
+        self.early_used: list[str] = []  #: the figures the final answer took from it
         self.error: str | None = None  #: why the helper failed, if it did
 
     @property
@@ -362,17 +417,24 @@ class FigureRenderer:
         payload: Any,
         omit: Any,
         finish: Any = None,
+        reuse: bool = False,
     ) -> bool:
         """Send one request; whether it went (else :attr:`error` says why, when it matters)."""
+        if self._too_large:
+            return False
+        request = (kind, make_jobs, payload, finish, reuse)
         try:
-            data = _dumps((kind, make_jobs, payload, finish), omit)
+            size = _pickled_size(request, omit)
+            if size <= MAX_PAYLOAD_BYTES:
+                data = _dumps(request, omit)
         except Exception as exc:  # e.g. a payload that does not pickle
             self.error = f"{type(exc).__name__}: {exc}"
             return False
-        if len(data) > MAX_PAYLOAD_BYTES:
+        if size > MAX_PAYLOAD_BYTES:
             # a large model's result (issue 11: 193 MB of mode shapes): copying it through
             # the pipe and unpickling it costs more than drawing here saves
-            self.error = f"the request is {len(data) / 1e6:.0f} MB: drawn in-process"
+            self._too_large = True
+            self.error = f"the request is {size / 1e6:.0f} MB: drawn in-process"
             return False
         self._post(data)
         return True
@@ -397,12 +459,17 @@ class FigureRenderer:
         Returns
         -------
         bool
-            Whether the request went (False: no helper, or a payload that does not pickle or
-            is too large; :meth:`render` then draws those figures with the others).
+            Whether the request went (False: no helper, an early request sent already, or a
+            payload that does not pickle or is too large; :meth:`render` then draws those
+            figures with the others).  The payload sent is kept as :attr:`early_payload`,
+            for the caller to check that its final request is made from the same values.
         """
-        if self._pid is None or self._requests is None:
+        if self._pid is None or self._requests is None or self.early_payload is not None:
             return False
-        return self._request("early", make_jobs, payload, omit)
+        sent = self._request("early", make_jobs, payload, omit)
+        if sent:
+            self.early_payload = payload
+        return sent
 
     def render(
         self,
@@ -411,6 +478,7 @@ class FigureRenderer:
         while_waiting: Callable[[], object] | None = None,
         omit: Callable[[object], bool] | None = None,
         finish: Callable[[Any, dict[str, bytes]], dict[str, Any]] | None = None,
+        reuse_early: bool = False,
     ) -> dict[str, Any] | None:
         """The PNG bytes of ``make_jobs(payload)``'s figures, drawn by the helpers.
 
@@ -431,6 +499,10 @@ class FigureRenderer:
             A module-level function (pickled by name), called in the helper with the
             payload and the figures once all are drawn: more files (name -> text or bytes)
             to return with them (e.g. the HTML page that embeds the figures).
+        reuse_early : bool
+            Take the figures of the early request (:meth:`draw_early`) for the final jobs of
+            the same names; the caller says so only when both requests come from the same
+            values (else the early figures are dropped and all are drawn).
 
         Returns
         -------
@@ -440,7 +512,7 @@ class FigureRenderer:
         """
         if self._pid is None or self._requests is None or self._replies is None:
             return None
-        if not self._request("final", make_jobs, payload, omit, finish):
+        if not self._request("final", make_jobs, payload, omit, finish, reuse_early):
             self.close()
             return None
         if while_waiting is not None:
@@ -448,6 +520,7 @@ class FigureRenderer:
         reply = receive(self._replies, time.monotonic() + TIMEOUT_S, self._pid)
         self.close()
         if isinstance(reply, tuple) and reply[0] == "ok":
+            self.early_used = list(reply[3])
             return {**reply[1], **reply[2]}
         self.error = reply[1] if isinstance(reply, tuple) else "the helper process stopped"
         return None
