@@ -296,3 +296,30 @@ def test_a_users_blas_thread_count_is_kept():
     out = _py(BLAS, OPENBLAS_NUM_THREADS="2")
     assert out["cores"] is None  # not set: the user chose
     assert out["start"] == [2] and out["large"] == [2] and out["small"] == [1]
+
+
+def test_an_error_after_the_early_figures_is_one_line_and_leaves_nothing(tmp_path: Path):
+    # dt too coarse for the modes is found once the modes are solved, after the helper got
+    # the early figures: one line, exit 2, no output, and no helper or drawer left behind
+    import time
+
+    out = tmp_path / "unique-out-dir"
+    argv = [sys.executable, "-m", "microg", "analyze", "--dt", "0.2", "--json", "--no-progress"]
+    argv += ["--out", str(out)]
+    proc = subprocess.run(argv, capture_output=True, text=True, env=_env(), timeout=300)
+    assert proc.returncode == 2 and proc.stdout == ""
+    assert len(proc.stderr.strip().splitlines()) == 1 and "--dt" in proc.stderr
+    assert not out.exists()
+    # nothing of the run is left (the kill itself is checked with a drawer that would sleep
+    # for 30 s: tests/report/test_report_render.py)
+    time.sleep(0.3)
+    left = []
+    for d in Path("/proc").iterdir():
+        if d.name.isdigit():
+            try:
+                cmd = (d / "cmdline").read_bytes().decode(errors="replace")
+            except OSError:
+                continue
+            if str(out) in cmd:
+                left.append(d.name)
+    assert left == []
