@@ -36,6 +36,7 @@ Method (:func:`solve_dense`), each step a documented choice:
 from __future__ import annotations
 
 import os
+import sys
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -78,6 +79,9 @@ MAX_LEVELS = 24
 BLAS_THREADS_MIN_N = 4000
 
 _CONTROLLER: Any = None
+#: whether scipy.linalg (and with it scipy's own OpenBLAS) was loaded when _CONTROLLER
+#: scanned the libraries: a controller made before it would leave scipy's BLAS unlimited
+_CONTROLLER_SAW_SCIPY = False
 
 
 def _large() -> int | None:
@@ -114,7 +118,7 @@ def blas_threads(n: int, threads: int | None = None) -> Iterator[None]:
     threads : int, optional
         An explicit count (None: by the rule above).
     """
-    global _CONTROLLER
+    global _CONTROLLER, _CONTROLLER_SAW_SCIPY
     want = threads if threads is not None else (1 if n < BLAS_THREADS_MIN_N else _large())
     if want is None or (want == 1 and _CONTROLLER is None and _started_on_one_thread()):
         # nothing to change: as they are, or still the one thread the process started with
@@ -122,10 +126,12 @@ def blas_threads(n: int, threads: int | None = None) -> Iterator[None]:
         yield
         return
     try:
-        if _CONTROLLER is None:
+        scipy_loaded = "scipy.linalg" in sys.modules  # scipy loads on first use
+        if _CONTROLLER is None or (scipy_loaded and not _CONTROLLER_SAW_SCIPY):
             from threadpoolctl import ThreadpoolController
 
-            _CONTROLLER = ThreadpoolController()
+            _CONTROLLER = ThreadpoolController()  # scans the BLAS libraries loaded now
+            _CONTROLLER_SAW_SCIPY = scipy_loaded
         ctx = _CONTROLLER.limit(limits=int(want), user_api="blas")
     except Exception:  # threadpoolctl missing or no BLAS found: nothing to limit
         yield
