@@ -30,7 +30,17 @@ from collections.abc import Callable
 from types import TracebackType
 from typing import Any
 
-__all__ = ["Forked", "can_fork", "exited", "pipe", "receive", "send", "usable_cpus", "write_all"]
+__all__ = [
+    "Forked",
+    "can_fork",
+    "exited",
+    "pipe",
+    "receive",
+    "receive_bytes",
+    "send",
+    "usable_cpus",
+    "write_all",
+]
 
 _HEADER = struct.Struct("<Q")
 
@@ -120,6 +130,14 @@ def _read_exact(fd: int, n: int, deadline: float | None, pid: int | None) -> byt
     return b"".join(chunks)
 
 
+def receive_bytes(fd: int, deadline: float | None = None, pid: int | None = None) -> bytes | None:
+    """One framed pickle from ``fd``, still pickled; None as :func:`receive` says."""
+    head = _read_exact(fd, _HEADER.size, deadline, pid)
+    if head is None:
+        return None
+    return _read_exact(fd, _HEADER.unpack(head)[0], deadline, pid)
+
+
 def receive(fd: int, deadline: float | None = None, pid: int | None = None) -> Any:
     """One framed pickle from ``fd``, unpickled; None at end of file, timeout or ``pid``'s death.
 
@@ -132,10 +150,7 @@ def receive(fd: int, deadline: float | None = None, pid: int | None = None) -> A
     pid : int, optional
         The writer, whose death ends the wait.
     """
-    head = _read_exact(fd, _HEADER.size, deadline, pid)
-    if head is None:
-        return None
-    body = _read_exact(fd, _HEADER.unpack(head)[0], deadline, pid)
+    body = receive_bytes(fd, deadline, pid)
     return None if body is None else pickle.loads(body)
 
 

@@ -69,6 +69,42 @@ def early_failing(payload):
 r = FigureRenderer.start((), processes=2)
 r.draw_early(early, 1)
 out["early"] = r.render(one, 1, reuse_early=True)  # a.png drawn early, x.png not asked
+def pid_png():
+    return str(os.getpid()).encode()
+
+
+def early_slow(payload):
+    return [FigureJob("e.png", 1.0, lambda: time.sleep(0.1) or pid_png())]
+
+
+def final_two(payload):
+    slow = lambda: time.sleep(0.25) or pid_png()  # noqa: E731
+    return [FigureJob(n, 1.0, slow) for n in ("e.png", "a.png", "b.png")]
+
+
+r = FigureRenderer.start((), processes=2)
+r.draw_early(early_slow, 1)  # still drawing when the final request comes, done before a.png
+shared = r.render(final_two, 1, reuse_early=True)
+out["early_shared"] = {k: int(v) for k, v in shared.items()} if shared else r.error
+
+
+def early_busy(payload):
+    return [FigureJob("e.png", 1.0, lambda: time.sleep(0.5) or pid_png())]
+
+
+def final_quick(payload):
+    return [FigureJob(n, 1.0, pid_png) for n in ("e.png", "a.png", "b.png")]
+
+
+r = FigureRenderer.start((), processes=2)
+r.draw_early(early_busy, 1)  # busy until after the helper has drawn its share
+shared = r.render(final_quick, 1, reuse_early=True)
+out["early_busy"] = {k: int(v) for k, v in shared.items()} if shared else r.error
+r = FigureRenderer.start((), processes=2)
+r.draw_early(early, 1)
+time.sleep(0.5)  # done before the final request comes
+shared = r.render(final_two, 1)  # not reused: the early drawer is stopped, all drawn again
+out["early_not_reused"] = {k: int(v) for k, v in shared.items()} if shared else r.error
 r = FigureRenderer.start((), processes=2)
 r.draw_early(early_failing, 1)
 out["early_failing"] = [r.render(one, 1, reuse_early=True), r.error]  # the final draws it
@@ -203,6 +239,19 @@ def test_the_helper_writes_the_same_report_page(forked):
     assert forked["report_error"] == [None, setup]
     assert forked["report_same"] == [True, True, "report.html"]
     assert forked["early_used"] == setup and forked["error"] is None
+
+
+def test_the_early_drawer_takes_a_share_of_the_final_jobs(forked):
+    # its own figure (0.1 s), then, free before the helper is done with its first final job
+    # (0.25 s), the other one (drawn there: its pid).  Without reuse the early figure is
+    # drawn again, by the helper or a fork
+    pids = forked["early_shared"]
+    assert pids["e.png"] in (pids["a.png"], pids["b.png"])  # the early drawer drew one
+    assert pids["a.png"] != pids["b.png"]  # and the helper the other
+    pids = forked["early_busy"]  # still busy when the helper is idle: it draws both
+    assert pids["a.png"] == pids["b.png"] != pids["e.png"]
+    pids = forked["early_not_reused"]
+    assert sorted(pids) == ["a.png", "b.png", "e.png"] and len(set(pids.values())) == 2
 
 
 def test_early_figures_of_another_analysis_are_not_used(forked):

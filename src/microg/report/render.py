@@ -38,7 +38,17 @@ from dataclasses import dataclass
 from types import TracebackType
 from typing import Any
 
-from microg._fork import can_fork, fork, pipe, receive, send, stop, usable_cpus, write_all
+from microg._fork import (
+    can_fork,
+    fork,
+    pipe,
+    receive,
+    receive_bytes,
+    send,
+    stop,
+    usable_cpus,
+    write_all,
+)
 
 __all__ = ["FigureJob", "FigureRenderer", "Omitted", "default_processes", "split_jobs"]
 
@@ -79,19 +89,25 @@ def default_processes() -> int:
     return max(1, min(MAX_PROCESSES, usable_cpus()))
 
 
-def split_jobs(weights: Sequence[float], parts: int) -> list[list[int]]:
+def split_jobs(
+    weights: Sequence[float], parts: int, loads: Sequence[float] | None = None
+) -> list[list[int]]:
     """Indices of ``weights`` shared into ``parts`` groups of nearly equal total weight.
 
-    Longest first, each into the lightest group so far (the LPT rule); each group keeps
-    the order of the input.
+    Longest first, each into the lightest group so far (the LPT rule), counting the work
+    each group has already (``loads``, default none); each group keeps the order of the
+    input.  Without ``loads`` the empty groups are dropped; with them the groups keep their
+    places (group k is the one that had ``loads[k]``).
     """
-    groups: list[list[int]] = [[] for _ in range(max(1, parts))]
-    load = [0.0] * len(groups)
+    n = max(1, parts) if loads is None else len(loads)
+    groups: list[list[int]] = [[] for _ in range(n)]
+    load = [0.0] * n if loads is None else [float(x) for x in loads]
     for i in sorted(range(len(weights)), key=lambda k: -weights[k]):
-        g = min(range(len(groups)), key=lambda k: load[k])
+        g = min(range(n), key=lambda k: load[k])
         groups[g].append(i)
         load[g] += weights[i]
-    return [sorted(g) for g in groups if g]
+    out = [sorted(g) for g in groups]
+    return out if loads is not None else [g for g in out if g]
 
 
 # ----------------------------------------------------------------------------- helper side
@@ -130,49 +146,104 @@ def _die_with(parent: int) -> None:
         os._exit(1)
 
 
-def _fork_drawer(jobs: Sequence[FigureJob], which: Sequence[int]) -> tuple[int, int]:
-    """Fork a process that draws ``jobs[which]`` and sends back their PNGs: (pid, pipe).
+@dataclass
+class _Drawer:
+    """A forked drawing process, the pipe of its replies, and its pipe for a second batch.
 
-    It dies with the helper (killed when its caller fails): nothing is left drawing.
+    Only the early drawer has the second pipe (``more``): it waits on it for a share of
+    the final jobs once its own are drawn.
+    """
+
+    pid: int
+    replies: int
+    more: int | None = None
+
+
+def _draw_checked(jobs: Sequence[FigureJob], which: Sequence[int], parent: int) -> dict:
+    out = {}
+    for i in which:
+        if os.getppid() != parent:  # orphaned: nobody will read the figures
+            raise SystemExit(1)
+        out[jobs[i].name] = jobs[i].draw()
+    return out
+
+
+def _fork_drawer(jobs: Sequence[FigureJob], which: Sequence[int], more: bool = False) -> _Drawer:
+    """Fork a process that draws ``jobs[which]`` and sends back their PNGs.
+
+    With ``more`` it then waits for a second batch from the helper: ``("draw", request,
+    names)``, a final request as the helper received it (pickled) and the names of its
+    jobs to draw, or anything else to stop.  It dies with the helper (killed when its
+    caller fails): nothing is left drawing.
     """
     r, w = pipe()
+    more_r, more_w = pipe() if more else (None, None)
     parent = os.getpid()
     pid = fork()
     if pid == 0:  # the drawing process
         code = 0
         try:
             os.close(r)
+            if more_w is not None:
+                os.close(more_w)
             _die_with(parent)
-            out = {}
-            for i in which:
-                if os.getppid() != parent:  # orphaned: nobody will read the figures
-                    raise SystemExit(1)
-                out[jobs[i].name] = jobs[i].draw()
-            send(w, ("ok", out))
+            send(w, ("ok", _draw_checked(jobs, which, parent)))
+            if more_r is not None:
+                batch = receive(more_r)
+                if isinstance(batch, tuple) and batch[0] == "draw":
+                    _, make_jobs, payload, *_ = pickle.loads(batch[1])
+                    final = make_jobs(payload)
+                    names = set(batch[2])
+                    which = [k for k, j in enumerate(final) if j.name in names]
+                    send(w, ("ok", _draw_checked(final, which, parent)))
         except BaseException:
             code = 1
         finally:
             os._exit(code)
     os.close(w)
-    return pid, r
+    if more_r is not None:
+        os.close(more_r)
+    return _Drawer(pid, r, more_w)
 
 
-def _discard(pid: int, r: int) -> None:
+def _send_quietly(fd: int, obj: Any) -> None:
+    """:func:`send`, with a reader that has gone ignored (its figures are drawn anyway)."""
+    with contextlib.suppress(OSError):
+        send(fd, obj)
+
+
+def _discard(drawer: _Drawer) -> None:
     """Stop a drawing process whose figures are not wanted, and reap it."""
     with contextlib.suppress(ProcessLookupError):
-        os.kill(pid, signal.SIGKILL)
-    os.close(r)
-    with contextlib.suppress(ChildProcessError):
-        os.waitpid(pid, 0)
+        os.kill(drawer.pid, signal.SIGKILL)
+    _close(drawer)
 
 
-def _collect(pid: int, r: int) -> dict[str, bytes] | None:
-    """A drawing process's PNGs (None if it failed), once it has sent them; reaps it."""
-    reply = receive(r, time.monotonic() + TIMEOUT_S, pid)
-    os.close(r)
+def _close(drawer: _Drawer) -> None:
+    for fd in (drawer.replies, drawer.more):
+        if fd is not None:
+            with contextlib.suppress(OSError):
+                os.close(fd)
     with contextlib.suppress(ChildProcessError):
-        os.waitpid(pid, 0)
+        os.waitpid(drawer.pid, 0)
+
+
+def _reply(drawer: _Drawer) -> dict[str, bytes] | None:
+    """A drawing process's next batch of PNGs; None if it failed or stopped."""
+    reply = receive(drawer.replies, time.monotonic() + TIMEOUT_S, drawer.pid)
     return dict(reply[1]) if isinstance(reply, tuple) and reply[0] == "ok" else None
+
+
+def _collect(drawer: _Drawer) -> dict[str, bytes] | None:
+    """A drawing process's PNGs (None if it failed), once it has sent them; reaps it."""
+    pngs = _reply(drawer)
+    _close(drawer)
+    return pngs
+
+
+#: the share of its work an early drawer still has when the final request comes (a guess,
+#: to balance the final jobs: the final request comes ~0.1 s into its ~0.25 s)
+_EARLY_LEFT = 0.5
 
 
 def _helper(
@@ -191,10 +262,11 @@ def _helper(
     ``"final"`` request is answered with its jobs' figures, each drawn once: with ``reuse``,
     a job named as an early one takes the early figure (the caller has checked that the
     early request was made from the same values); without, the early drawer is stopped.
-    The other final jobs are drawn here (the early drawer still has the second core), or
-    shared with ``processes - 1`` more forks when the early drawer is done or there was
-    none.  The final request's ``finish`` (if any) makes more files from its payload and the
-    figures.  The reply names the figures taken from the early request.
+    The other final jobs are shared between this process and the early drawer, once it is
+    done with its own (by the LPT rule, counting what it has left), or with ``processes -
+    1`` more forks when there was none.  The final request's ``finish`` (if any) makes
+    more files from its payload and the figures.  The reply names the figures taken from
+    the early request.
     """
     status = 0
     try:
@@ -209,8 +281,8 @@ def _helper(
         for name in then:
             importlib.import_module(name)
         warmed = False
-        early: tuple[int, int] | None = None  # the early drawer: (pid, pipe)
-        early_names: set[str] = set()
+        early: _Drawer | None = None  # the early drawer
+        early_jobs: list[FigureJob] = []
         final: list[FigureJob] | None = None
         while final is None:
             if warm is not None and not warmed and not _readable(requests):
@@ -219,41 +291,77 @@ def _helper(
                 with contextlib.suppress(Exception):
                     warm()
                 continue
-            request = receive(requests)
-            if request is None:  # the caller finished without (more) figures
+            raw = receive_bytes(requests)
+            if raw is None:  # the caller finished without (more) figures
                 return
-            kind, make_jobs, payload, finish, reuse = request
+            kind, make_jobs, payload, finish, reuse = pickle.loads(raw)
             if kind == "final":
                 final = make_jobs(payload)
             elif early is None:
                 with contextlib.suppress(Exception):
                     jobs: list[FigureJob] = make_jobs(payload)
                     if jobs:
-                        early = _fork_drawer(jobs, range(len(jobs)))
-                        early_names = {j.name for j in jobs}
+                        early = _fork_drawer(jobs, range(len(jobs)), more=True)
+                        early_jobs = jobs
         if early is not None and not reuse:
-            _discard(*early)
-            early, early_names = None, set()
-        drawn: dict[str, bytes] = {}
-        if early is not None and _readable(early[1]):  # done already
-            drawn.update(_collect(*early) or {})
+            _discard(early)
             early = None
+        drawn: dict[str, bytes] = {}
+        done = False  # whether the early figures are in
+        if early is not None and _readable(early.replies):
+            done = True
+            drawn.update(_reply(early) or {})
         taken = set(drawn)
-        busy = early_names if early is not None else set()
+        busy = {j.name for j in early_jobs} if early is not None and not done else set()
         todo = [j for j in final if j.name not in drawn and j.name not in busy]
-        groups = split_jobs([j.weight for j in todo], 1 if early is not None else processes)
-        children = [_fork_drawer(todo, g) for g in groups[1:]]
-        if groups:
+        weights = [j.weight for j in todo]
+        children: list[_Drawer] = []
+        sender: threading.Thread | None = None
+        if early is not None and early.more is not None:
+            # the early drawer takes a share of the final jobs once it is free: this process
+            # draws its own share, and between its figures hands the drawer its share if it
+            # has finished its own figures, or takes the share back if this one is idle first
+            left = 0.0 if done else _EARLY_LEFT * sum(j.weight for j in early_jobs)
+            mine, theirs = split_jobs(weights, 2, loads=[0.0, left])
+            queue = list(mine)
+            sent = False
+            while queue or (theirs and not sent):
+                if theirs and not sent and (done or _readable(early.replies)):
+                    if not done:  # its own figures (a failure: drawn below)
+                        late = _reply(early) or {}
+                        drawn.update({k: v for k, v in late.items() if k not in drawn})
+                        taken |= set(late)
+                        done = True
+                    # from a thread: a large request fills the pipe, and this process goes
+                    # on drawing (it forks no more: a thread is safe here)
+                    batch = ("draw", raw, [todo[i].name for i in theirs])
+                    sender = threading.Thread(target=_send_quietly, args=(early.more, batch))
+                    sender.start()
+                    sent = True
+                elif queue:
+                    drawn.update(_draw(todo, [queue.pop(0)]))
+                else:  # idle while the drawer is still busy: its share is drawn here
+                    queue, theirs = list(theirs), []
+            if not sent:
+                _send_quietly(early.more, ("stop",))
+            if not done:
+                late = _reply(early) or {}
+                drawn.update({k: v for k, v in late.items() if k not in drawn})
+                taken |= set(late)
+            if sent:
+                drawn.update(_reply(early) or {})  # its share (a failure: drawn below)
+                if sender is not None:
+                    sender.join()  # done, or failed on a drawer that is gone
+            _close(early)
+        else:
+            groups = split_jobs(weights, processes) or [[]]
+            children = [_fork_drawer(todo, g) for g in groups[1:]]
             drawn.update(_draw(todo, groups[0]))
-        for pid, r in children:
-            pngs = _collect(pid, r)
-            if pngs is None:
-                raise RuntimeError("a drawing process failed")
-            drawn.update(pngs)
-        if early is not None:
-            late = _collect(*early) or {}  # a failed early drawer: drawn here below
-            drawn.update({k: v for k, v in late.items() if k not in drawn})
-            taken |= set(late)
+            for child in children:
+                pngs = _collect(child)
+                if pngs is None:
+                    raise RuntimeError("a drawing process failed")
+                drawn.update(pngs)
         missing = [j for j in final if j.name not in drawn]
         drawn.update(_draw(missing, range(len(missing))))
         pngs = {j.name: drawn[j.name] for j in final}
