@@ -3,17 +3,23 @@
 ``microg analyze`` spends more time importing matplotlib and drawing its figures than
 computing (issue 8, "Speed of the main job").  A :class:`FigureRenderer` started before the
 computation forks one helper process, which imports the plotting modules (and warms the font
-cache) on another core while the caller computes; when the result is ready, the caller sends
-it (pickled) and the helper forks once more, so that two processes draw shares of the figures
-while the caller prepares the HTML.  The caller itself never imports matplotlib.
+cache, and loads what a ``warm`` step asks, e.g. the HTML template) on another core while
+the caller computes.  The caller may send an early request as soon as some figures can be
+drawn (:meth:`FigureRenderer.draw_early`: the model's, once its modes are solved); the
+helper forks an early drawer for them.  When the result is ready the caller sends it
+(:meth:`FigureRenderer.render`); the helper and the early drawer (or a second fork) share
+its figures, and a ``finish`` step may make more files from them (the HTML page).  The
+caller itself never imports matplotlib.  Requests leave out what no figure reads
+(``omit``: a structure's sparse matrices), so the helper need not import scipy.
 
 The PNG bytes are the same as those drawn in-process: the helpers are forks of the caller,
 with its matplotlib settings.  Anything unexpected (no ``os.fork``, one CPU, other threads
 running in the caller, a result that does not pickle or pickles larger than
 :data:`MAX_PAYLOAD_BYTES`, a helper that fails or dies) makes
-:meth:`FigureRenderer.render` return ``None``, and the caller draws in-process as before.
-The environment variable ``MICROG_FIGURE_PROCESSES`` sets the number of drawing processes
-(``1``: no helper; default: 2 where two CPUs are available).
+:meth:`FigureRenderer.render` return ``None``, and the caller draws in-process as before;
+drawing processes die with their helper.  The environment variable
+``MICROG_FIGURE_PROCESSES`` sets the number of drawing processes (``1``: no helper;
+default: 2 where two CPUs are available).
 
 This is for a command-line run (one process per job): ``microg analyze`` starts one before
 it loads the model (:mod:`microg.cli.analyze`).  A library caller (a notebook, a server)
