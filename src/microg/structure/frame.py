@@ -1380,17 +1380,7 @@ def build_frame(
 
     samples = _samples(graph, fm.positions, fm.names, T, retained, massless, X, n_ind)
 
-    def node_map(name: str, position: np.ndarray | None = None) -> PointMap:
-        i = graph.node_index()[name]
-        pos = P[i] if position is None else np.asarray(position, float)
-        rows6 = T[6 * i : 6 * i + 6]
-        full = np.zeros((6, n_ind))
-        full[:] = rows6.toarray()
-        coords = full[:, retained] + (full[:, massless] @ X if massless.size else 0.0)
-        link = rigid_link(pos - P[i])
-        tr = link[:3] @ coords
-        return PointMap(name=name, position=pos.copy(), translation=tr, rotation=coords[3:].copy())
-
+    node_map = _NodeMap(graph.node_index(), P, T, retained, massless, X, n_ind)
     named = {p.name: _named_map(node_map, p) for p in graph.points}
     points = _PointMaps(named, node_map, {nd.name for nd in graph.nodes})
     meta = {
@@ -1511,6 +1501,50 @@ def _mass_basis(
         shape=(n, n),
     )
     return Q, null, labels
+
+
+@dataclass(frozen=True)
+class _NodeMap:
+    """The point map of a node, or of a position carried rigidly by it.
+
+    A class rather than a closure, so that a frame model's structure pickles (for the
+    figure helper of ``microg analyze`` and for process pools).
+
+    Attributes
+    ----------
+    index : dict of str to int
+        Node name -> row of ``positions``.
+    positions : ndarray (n, 3)
+        Node positions, m.
+    transform : sparse matrix (6 n, n_ind)
+        Node DOFs from the independent coordinates.
+    retained, massless : ndarray of int
+        Independent coordinates kept, and those condensed out by ``condensed``.
+    condensed : ndarray or None
+        The massless coordinates as a function of the retained ones.
+    n_ind : int
+        Number of independent coordinates.
+    """
+
+    index: dict[str, int]
+    positions: np.ndarray
+    transform: Any
+    retained: np.ndarray
+    massless: np.ndarray
+    condensed: Any
+    n_ind: int
+
+    def __call__(self, name: str, position: np.ndarray | None = None) -> PointMap:
+        i = self.index[name]
+        node = self.positions[i]
+        pos = node if position is None else np.asarray(position, float)
+        full = np.zeros((6, self.n_ind))
+        full[:] = self.transform[6 * i : 6 * i + 6].toarray()
+        coords = full[:, self.retained] + (
+            full[:, self.massless] @ self.condensed if self.massless.size else 0.0
+        )
+        tr = rigid_link(pos - node)[:3] @ coords
+        return PointMap(name=name, position=pos.copy(), translation=tr, rotation=coords[3:].copy())
 
 
 def _named_map(node_map: Any, p: GraphPoint) -> PointMap:
