@@ -34,10 +34,12 @@ __all__ = [
     "Forked",
     "can_fork",
     "exited",
+    "fork",
     "pipe",
     "receive",
     "receive_bytes",
     "send",
+    "stop",
     "usable_cpus",
     "write_all",
 ]

@@ -132,8 +132,16 @@ def _warm_up() -> None:
     png_bytes(finish(fig), dpi=20)
 
 
-def _draw(jobs: Sequence[FigureJob], which: Sequence[int]) -> dict[str, bytes]:
-    return {jobs[i].name: jobs[i].draw() for i in which}
+def _draw(
+    jobs: Sequence[FigureJob], which: Sequence[int], parent: int | None = None
+) -> dict[str, bytes]:
+    """PNG bytes of ``jobs[which]`` by name; with ``parent``, stop if it has gone between them."""
+    out = {}
+    for i in which:
+        if parent is not None and os.getppid() != parent:  # orphaned: nobody will read them
+            raise SystemExit(1)
+        out[jobs[i].name] = jobs[i].draw()
+    return out
 
 
 def _readable(fd: int) -> bool:
@@ -165,15 +173,6 @@ class _Drawer:
     more: int | None = None
 
 
-def _draw_checked(jobs: Sequence[FigureJob], which: Sequence[int], parent: int) -> dict:
-    out = {}
-    for i in which:
-        if os.getppid() != parent:  # orphaned: nobody will read the figures
-            raise SystemExit(1)
-        out[jobs[i].name] = jobs[i].draw()
-    return out
-
-
 def _fork_drawer(jobs: Sequence[FigureJob], which: Sequence[int], more: bool = False) -> _Drawer:
     """Fork a process that draws ``jobs[which]`` and sends back their PNGs.
 
@@ -193,7 +192,7 @@ def _fork_drawer(jobs: Sequence[FigureJob], which: Sequence[int], more: bool = F
             if more_w is not None:
                 os.close(more_w)
             _die_with(parent)
-            send(w, ("ok", _draw_checked(jobs, which, parent)))
+            send(w, ("ok", _draw(jobs, which, parent)))
             if more_r is not None:
                 batch = receive(more_r)
                 if isinstance(batch, tuple) and batch[0] == "draw":
@@ -201,7 +200,7 @@ def _fork_drawer(jobs: Sequence[FigureJob], which: Sequence[int], more: bool = F
                     final = make_jobs(payload)
                     names = set(batch[2])
                     which = [k for k, j in enumerate(final) if j.name in names]
-                    send(w, ("ok", _draw_checked(final, which, parent)))
+                    send(w, ("ok", _draw(final, which, parent)))
         except BaseException:
             code = 1
         finally:
