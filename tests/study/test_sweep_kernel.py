@@ -275,3 +275,23 @@ dt = "0.005 s"
     bad = text.replace('"grid:24"', '"grid:10"')
     with pytest.raises(InputError, match="grid:N for a grid of the model"):
         loads_study(bad, filename="modal.toml")
+
+
+def test_a_scatter_is_bounded_and_a_timed_out_one_is_tried_again(monkeypatch) -> None:
+    # a scatter racing a worker's restart once waited without end in CI: every attempt
+    # carries a timeout, and a timeout (an OSError) is tried again
+    import microg.study.run as run
+
+    monkeypatch.setattr("time.sleep", lambda s: None)
+    calls: list[dict] = []
+
+    class Client:
+        def scatter(self, data, **kwargs):
+            calls.append(kwargs)
+            if len(calls) == 1:
+                raise TimeoutError("scatter timed out")
+            return "future"
+
+    assert run._scatter(Client(), [1, 2], True) == "future"
+    assert len(calls) == 2  # the timed-out attempt, then one that went
+    assert all(c["timeout"] == run.SCATTER_TIMEOUT_S > 0 for c in calls)

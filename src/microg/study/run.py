@@ -55,6 +55,9 @@ TASK_CASES = 1024
 TASK_GROUPS = 8
 #: seconds to wait for a scheduler to answer and to have a worker
 CONNECT_TIMEOUT_S = 10.0
+#: seconds one scatter may take before it is tried again: a scatter racing a worker's
+#: restart can otherwise wait without end (seen once in CI); a model of ~200 MB moves in ~2 s
+SCATTER_TIMEOUT_S = 30.0
 #: tasks in flight per worker thread
 IN_FLIGHT_PER_THREAD = 2
 
@@ -404,12 +407,15 @@ def _lost(exc: BaseException) -> bool:
 
 
 def _scatter(client: Any, data: Any, broadcast: bool) -> Any:
-    """``client.scatter``, again after a moment if a worker is leaving (a restart is racing)."""
+    """``client.scatter``, again after a moment if a worker is leaving (a restart is racing).
+
+    Each attempt is bounded (:data:`SCATTER_TIMEOUT_S`; a timeout is an OSError).
+    """
     import time
 
     for attempt in range(5):
         try:
-            return client.scatter(data, broadcast=broadcast, hash=False)
+            return client.scatter(data, broadcast=broadcast, hash=False, timeout=SCATTER_TIMEOUT_S)
         except (KeyError, OSError):
             if attempt == 4:
                 raise
