@@ -100,6 +100,33 @@ r = FigureRenderer.start((), processes=2)
 r.draw_early(early_busy, 1)  # busy until after the helper has drawn its share
 shared = r.render(final_quick, 1, reuse_early=True)
 out["early_busy"] = {k: int(v) for k, v in shared.items()} if shared else r.error
+
+
+def stamp_png(sleep_s):
+    return lambda: time.sleep(sleep_s) or f"{os.getpid()} {time.monotonic()}".encode()
+
+
+def final_uneven(payload):
+    # the same weight, not the same cost: a static share would give the helper two jobs
+    jobs = [FigureJob("e.png", 1.0, stamp_png(0.1))]
+    return jobs + [FigureJob(n, 1.0, stamp_png(s)) for n, s in (("a", 0.6), ("b", 0.05),
+                                                                ("c", 0.05), ("d", 0.05))]
+
+
+def final_weighted(payload):
+    return [FigureJob(n, w, stamp_png(0.02)) for n, w in (("e.png", 1.0), ("a", 1.0),
+                                                          ("b", 3.0), ("c", 2.0))]
+
+
+r = FigureRenderer.start((), processes=2)
+r.draw_early(early_slow, 1)
+shared = r.render(final_uneven, 1, reuse_early=True)
+out["early_uneven"] = {k: v.decode().split() for k, v in shared.items()} if shared else r.error
+r = FigureRenderer.start((), processes=2)
+r.draw_early(early_busy, 1)  # busy throughout: the helper draws a, b and c, heaviest first
+time.sleep(0.2)  # the early drawer has taken e.png
+shared = r.render(final_weighted, 1, reuse_early=True)
+out["early_weighted"] = {k: v.decode().split() for k, v in shared.items()} if shared else r.error
 r = FigureRenderer.start((), processes=2)
 r.draw_early(early, 1)
 time.sleep(0.5)  # done before the final request comes
@@ -252,6 +279,25 @@ def test_the_early_drawer_takes_a_share_of_the_final_jobs(forked):
     assert pids["a.png"] == pids["b.png"] != pids["e.png"]
     pids = forked["early_not_reused"]
     assert sorted(pids) == ["a.png", "b.png", "e.png"] and len(set(pids.values())) == 2
+
+
+def test_whoever_is_free_takes_the_next_job(forked):
+    # the helper takes a (0.6 s); the early drawer, free after e (0.1 s), takes b, c and d
+    # (0.05 s each) one after the other: the processes end near each other whatever the
+    # weights said
+    got = forked["early_uneven"]
+    assert all(isinstance(v, list) for v in got.values()), got
+    pid = {k: v[0] for k, v in got.items()}
+    assert pid["b"] == pid["c"] == pid["d"] == pid["e.png"] != pid["a"]
+    assert max(float(got[k][1]) for k in "bcd") < float(got["a"][1])
+
+
+def test_the_heaviest_job_is_taken_first(forked):
+    got = forked["early_weighted"]
+    assert all(isinstance(v, list) for v in got.values()), got
+    assert got["a"][0] == got["b"][0] == got["c"][0] != got["e.png"][0]  # the helper's
+    order = sorted("abc", key=lambda k: float(got[k][1]))
+    assert order == ["b", "c", "a"]  # weights 3, 2, 1
 
 
 def test_early_figures_of_another_analysis_are_not_used(forked):

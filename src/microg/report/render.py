@@ -7,8 +7,10 @@ cache, and loads what a ``warm`` step asks, e.g. the HTML template) on another c
 the caller computes.  The caller may send an early request as soon as some figures can be
 drawn (:meth:`FigureRenderer.draw_early`: the model's, once its modes are solved); the
 helper forks an early drawer for them.  When the result is ready the caller sends it
-(:meth:`FigureRenderer.render`); the helper and the early drawer (or a second fork) share
-its figures, and a ``finish`` step may make more files from them (the HTML page).  The
+(:meth:`FigureRenderer.render`); the helper and the early drawer (or a second fork) take
+the figures left one at a time, the heaviest first, whoever is free (so they finish
+within about one figure of each other whatever each costs), and a ``finish`` step may
+make more files from them (the HTML page).  The
 caller itself never imports matplotlib.  Requests leave out what no figure reads
 (``omit``: a structure's sparse matrices), so the helper need not import scipy.
 
@@ -36,6 +38,7 @@ import os
 import pickle
 import select
 import signal
+import sys
 import threading
 import time
 import traceback
@@ -162,93 +165,170 @@ def _die_with(parent: int) -> None:
 
 @dataclass
 class _Drawer:
-    """A forked drawing process, the pipe of its replies, and its pipe for a second batch.
+    """A forked drawing process: its pid, the pipe of its PNGs, the pipe of its orders.
 
-    Only the early drawer has the second pipe (``more``): it waits on it for a share of
-    the final jobs once its own are drawn.
+    ``has_final``: it was forked with the final jobs (else it is sent the final request).
     """
 
     pid: int
     replies: int
-    more: int | None = None
+    orders: int
+    has_final: bool = False
 
 
-def _fork_drawer(jobs: Sequence[FigureJob], which: Sequence[int], more: bool = False) -> _Drawer:
-    """Fork a process that draws ``jobs[which]`` and sends back their PNGs.
+def _fork_drawer(early: Sequence[FigureJob], final: Sequence[FigureJob] | None) -> _Drawer:
+    """Fork a process that draws, one at a time, the jobs the helper hands it.
 
-    With ``more`` it then waits for a second batch from the helper: ``("draw", request,
-    names)``, a final request as the helper received it (pickled) and the names of its
-    jobs to draw, or anything else to stop.  It dies with the helper (killed when its
-    caller fails): nothing is left drawing.
+    It asks for a job (``("next",)``, then with each PNG ``("png", kind, index, bytes)``) and
+    is answered ``(kind, index, request)``: ``early[index]``, or with kind ``"final"`` the
+    final job ``index``, the final jobs made the first time from ``request`` (the final
+    request as the helper received it, pickled) when it was forked before them (``final``
+    None); anything else stops it.  It dies with the helper (killed when its caller fails):
+    nothing is left drawing.
     """
     r, w = pipe()
-    more_r, more_w = pipe() if more else (None, None)
+    orders_r, orders_w = pipe()
     parent = os.getpid()
     pid = fork()
     if pid == 0:  # the drawing process
         code = 0
         try:
             os.close(r)
-            if more_w is not None:
-                os.close(more_w)
+            os.close(orders_w)
             _die_with(parent)
-            send(w, ("ok", _draw(jobs, which, parent)))
-            if more_r is not None:
-                batch = receive(more_r)
-                if isinstance(batch, tuple) and batch[0] == "draw":
-                    _, make_jobs, payload, *_ = pickle.loads(batch[1])
-                    final = make_jobs(payload)
-                    names = set(batch[2])
-                    which = [k for k, j in enumerate(final) if j.name in names]
-                    send(w, ("ok", _draw(final, which, parent)))
+            jobs: dict[str, list[FigureJob] | None] = {
+                "early": list(early),
+                "final": None if final is None else list(final),
+            }
+            reply: tuple[Any, ...] = ("next",)
+            while True:
+                send(w, reply)
+                order = receive(orders_r)
+                if not isinstance(order, tuple) or order[0] not in jobs:
+                    break
+                kind, index, request = order
+                todo = jobs[kind]
+                if todo is None:
+                    _, make_jobs, payload, *_ = pickle.loads(request)
+                    todo = jobs[kind] = make_jobs(payload)
+                reply = ("png", kind, index, _draw(todo, [index], parent).popitem()[1])
         except BaseException:
             code = 1
         finally:
             os._exit(code)
     os.close(w)
-    if more_r is not None:
-        os.close(more_r)
-    return _Drawer(pid, r, more_w)
-
-
-def _send_quietly(fd: int, obj: Any) -> None:
-    """:func:`send`, with a reader that has gone ignored (its figures are drawn anyway)."""
-    with contextlib.suppress(OSError):
-        send(fd, obj)
-
-
-def _discard(drawer: _Drawer) -> None:
-    """Stop a drawing process whose figures are not wanted, and reap it."""
-    with contextlib.suppress(ProcessLookupError):
-        os.kill(drawer.pid, signal.SIGKILL)
-    _close(drawer)
+    os.close(orders_r)
+    return _Drawer(pid, r, orders_w, has_final=final is not None)
 
 
 def _close(drawer: _Drawer) -> None:
-    for fd in (drawer.replies, drawer.more):
-        if fd is not None:
-            with contextlib.suppress(OSError):
-                os.close(fd)
+    """Release a drawing process's pipes and reap it (it has stopped, or is told to)."""
+    for fd in (drawer.replies, drawer.orders):
+        with contextlib.suppress(OSError):
+            os.close(fd)
     with contextlib.suppress(ChildProcessError):
         os.waitpid(drawer.pid, 0)
 
 
-def _reply(drawer: _Drawer) -> dict[str, bytes] | None:
-    """A drawing process's next batch of PNGs; None if it failed or stopped."""
-    reply = receive(drawer.replies, time.monotonic() + TIMEOUT_S, drawer.pid)
-    return dict(reply[1]) if isinstance(reply, tuple) and reply[0] == "ok" else None
+class _Queue:
+    """The jobs left to draw, taken one at a time by the helper and by its drawing processes.
+
+    The jobs are ``(kind, index)`` into ``jobs[kind]`` (``"early"``, ``"final"``), the
+    heaviest first: whoever is free takes the next, so the processes finish within about one
+    figure of each other whatever each job costs.  A thread of the helper serves each drawing
+    process (:meth:`serve`); the lock is the condition's.
+    """
+
+    def __init__(self, early: list[FigureJob]) -> None:
+        self.cond = threading.Condition()
+        self.jobs: dict[str, list[FigureJob]] = {"early": early, "final": []}
+        self.todo: list[tuple[str, int]] = self._heaviest_first("early", range(len(early)))
+        self.drawn: dict[tuple[str, int], bytes] = {}
+        self.busy: dict[int, tuple[str, int] | None] = {}  # drawer pid -> its job
+        self.final_request: bytes | None = None  # the pickled final request, once it came
+        self.closed = False  # no more jobs will come: a free drawer stops
+
+    def _heaviest_first(self, kind: str, which: Any) -> list[tuple[str, int]]:
+        jobs = self.jobs[kind]
+        return [(kind, i) for i in sorted(which, key=lambda i: -jobs[i].weight)]
+
+    def set_final(self, final: list[FigureJob], raw: bytes, reuse: bool) -> None:
+        """The final jobs: those not among the early ones (all of them without ``reuse``)."""
+        with self.cond:
+            early = self.jobs["early"]
+            names = {j.name for j in final}
+            if reuse:  # the early jobs still wanted, then the final jobs not drawn early
+                self.todo = [t for t in self.todo if early[t[1]].name in names]
+                skip = {j.name for j in early}
+            else:  # the early figures are not used: none is drawn any more
+                self.todo, skip = [], set()
+            self.jobs["final"] = final
+            wanted = [i for i, j in enumerate(final) if j.name not in skip]
+            self.todo = sorted(
+                self.todo + self._heaviest_first("final", wanted),
+                key=lambda t: -self.jobs[t[0]][t[1]].weight,
+            )
+            self.final_request = raw
+            self.closed = True
+            self.cond.notify_all()
+
+    def take(self, pid: int) -> tuple[str, int] | None:
+        """The next job for ``pid`` (0: the helper); None when none is left."""
+        with self.cond:
+            while not self.todo and not self.closed:
+                self.cond.wait()
+            job = self.todo.pop(0) if self.todo else None
+            self.busy[pid] = job
+            return job
+
+    def done(self, pid: int, job: tuple[str, int] | None, png: bytes | None) -> None:
+        """Record ``pid``'s figure (None: it failed, or it is gone)."""
+        with self.cond:
+            if job is not None and png is not None:
+                self.drawn[job] = png
+            self.busy[pid] = None
+            self.cond.notify_all()
+
+    def serve(self, drawer: _Drawer) -> None:
+        """Hand ``drawer`` its jobs, one at a time, until none is left or it is gone."""
+        sent_final = drawer.has_final
+        job: tuple[str, int] | None = None
+        try:
+            while True:
+                reply = receive(drawer.replies, time.monotonic() + TIMEOUT_S, drawer.pid)
+                if not isinstance(reply, tuple):
+                    break  # it died (its job is drawn by the helper)
+                if reply[0] == "png":
+                    self.done(drawer.pid, (reply[1], reply[2]), reply[3])
+                job = self.take(drawer.pid)
+                if job is None:
+                    break
+                request = None
+                if job[0] == "final" and not sent_final:
+                    request, sent_final = self.final_request, True
+                send(drawer.orders, (*job, request))
+        except BaseException:  # a drawer that is gone: what it held is drawn by the helper
+            pass
+        finally:
+            with contextlib.suppress(OSError):
+                send(drawer.orders, ("stop",))
+            self.done(drawer.pid, None, None)
+
+    def wait_idle(self, idle: Callable[[], None]) -> None:
+        """Return when no drawing process holds a job; ``idle()`` runs first if one does."""
+        with self.cond:
+            if not any(self.busy.values()):
+                return
+        idle()
+        with self.cond:
+            self.cond.wait_for(lambda: not any(self.busy.values()), TIMEOUT_S)
 
 
-def _collect(drawer: _Drawer) -> dict[str, bytes] | None:
-    """A drawing process's PNGs (None if it failed), once it has sent them; reaps it."""
-    pngs = _reply(drawer)
-    _close(drawer)
-    return pngs
-
-
-#: the share of its work an early drawer still has when the final request comes (a guess,
-#: to balance the final jobs: the final request comes ~0.1 s into its ~0.25 s)
-_EARLY_LEFT = 0.5
+def _serve(queue: _Queue, drawer: _Drawer) -> threading.Thread:
+    """A started thread handing ``drawer`` its jobs from ``queue`` (:meth:`_Queue.serve`)."""
+    server = threading.Thread(target=queue.serve, args=(drawer,), daemon=True)
+    server.start()
+    return server
 
 
 def _helper(
@@ -262,16 +342,15 @@ def _helper(
     """The helper process: load, warm up, load more; draw the early request; answer the final.
 
     Requests are ``(kind, make_jobs, payload, finish, reuse)``.  The first ``"early"``
-    request's jobs are drawn at once by a forked drawing process, while the caller still
-    computes (one whose jobs cannot be made is ignored: the final one draws them).  The
-    ``"final"`` request is answered with its jobs' figures, each drawn once: with ``reuse``,
-    a job named as an early one takes the early figure (the caller has checked that the
-    early request was made from the same values); without, the early drawer is stopped.
-    The other final jobs are shared between this process and the early drawer, once it is
-    done with its own (by the LPT rule, counting what it has left), or with ``processes -
-    1`` more forks when there was none.  The final request's ``finish`` (if any) makes
-    more files from its payload and the figures.  The reply names the figures taken from
-    the early request.
+    request's jobs go to a forked drawing process at once, while the caller still computes
+    (one whose jobs cannot be made is ignored: the final one draws them).  The ``"final"``
+    request is answered with its jobs' figures, each drawn once: with ``reuse``, a job named
+    as an early one takes the early figure (the caller has checked that the early request
+    was made from the same values); without, the early figures are not used.  The jobs left
+    are taken one at a time, heaviest first, by this process and the drawing processes
+    (:class:`_Queue`; with no early request, ``processes - 1`` are forked then).  The final
+    request's ``finish`` (if any) makes more files from its payload and the figures.  The
+    reply names the figures taken from the early request.
     """
     status = 0
     try:
@@ -285,89 +364,72 @@ def _helper(
             _warm_up()
         for name in then:
             importlib.import_module(name)
-        warmed = False
-        early: _Drawer | None = None  # the early drawer
-        early_jobs: list[FigureJob] = []
-        final: list[FigureJob] | None = None
-        while final is None:
-            if warm is not None and not warmed and not _readable(requests):
-                # no request waiting (or the early drawer just started): the time is free
+        warmed = warm is None
+
+        def warm_now() -> None:
+            """The ``warm`` step, once, when nothing else waits (its errors are ignored)."""
+            nonlocal warmed
+            if not warmed:
                 warmed = True
                 with contextlib.suppress(Exception):
-                    warm()
+                    warm()  # type: ignore[misc]
+
+        queue: _Queue | None = None
+        drawers: list[_Drawer] = []
+        servers: list[threading.Thread] = []
+        final: list[FigureJob] | None = None
+        final_raw = b""
+        while final is None:
+            if queue is None and not warmed and not _readable(requests):
+                # no request waiting: the time is free (once the early jobs are drawing, the
+                # final request comes soon: the warm step waits for an idle moment then)
+                warm_now()
                 continue
             raw = receive_bytes(requests)
             if raw is None:  # the caller finished without (more) figures
                 return
             kind, make_jobs, payload, finish, reuse = pickle.loads(raw)
             if kind == "final":
-                final = make_jobs(payload)
-            elif early is None:
+                final, final_raw = make_jobs(payload), raw
+            elif queue is None:
                 with contextlib.suppress(Exception):
                     jobs: list[FigureJob] = make_jobs(payload)
                     if jobs:
-                        early = _fork_drawer(jobs, range(len(jobs)), more=True)
-                        early_jobs = jobs
-        if early is not None and not reuse:
-            _discard(early)
-            early = None
+                        # a thread serves it from now on: this process forks no more
+                        drawers = [_fork_drawer(jobs, None)]
+                        queue = _Queue(jobs)
+                        servers = [_serve(queue, drawers[0])]
+        if queue is None:  # no early request: drawing processes for the final jobs
+            queue = _Queue([])
+            drawers = [_fork_drawer([], final) for _ in range(processes - 1)]
+            servers = [_serve(queue, d) for d in drawers]  # threads once all are forked
+        queue.set_final(final, final_raw, bool(reuse))
+        # a drawing process waiting for its next job waits for the GIL of this one, which
+        # draws meanwhile: hand it over within 1 ms, not the default 5 ms
+        sys.setswitchinterval(0.001)
+        while (job := queue.take(0)) is not None:
+            png = None
+            try:
+                png = _draw(queue.jobs[job[0]], [job[1]]).popitem()[1]
+            except Exception:
+                if job[0] != "early":
+                    raise
+                # an early job that fails is drawn again from the final request below
+            queue.done(0, job, png)
+        queue.wait_idle(warm_now)  # the warm step while the last figures are drawn
+        for server in servers:
+            server.join(TIMEOUT_S)
+        for drawer in drawers:
+            _close(drawer)
         drawn: dict[str, bytes] = {}
-        done = False  # whether the early figures are in
-        if early is not None and _readable(early.replies):
-            done = True
-            drawn.update(_reply(early) or {})
-        taken = set(drawn)
-        busy = {j.name for j in early_jobs} if early is not None and not done else set()
-        todo = [j for j in final if j.name not in drawn and j.name not in busy]
-        weights = [j.weight for j in todo]
-        children: list[_Drawer] = []
-        sender: threading.Thread | None = None
-        if early is not None and early.more is not None:
-            # the early drawer takes a share of the final jobs once it is free: this process
-            # draws its own share, and between its figures hands the drawer its share if it
-            # has finished its own figures, or takes the share back if this one is idle first
-            left = 0.0 if done else _EARLY_LEFT * sum(j.weight for j in early_jobs)
-            mine, theirs = split_jobs(weights, 2, loads=[0.0, left])
-            queue = list(mine)
-            sent = False
-            while queue or (theirs and not sent):
-                if theirs and not sent and (done or _readable(early.replies)):
-                    if not done:  # its own figures (a failure: drawn below)
-                        late = _reply(early) or {}
-                        drawn.update({k: v for k, v in late.items() if k not in drawn})
-                        taken |= set(late)
-                        done = True
-                    # from a thread: a large request fills the pipe, and this process goes
-                    # on drawing (it forks no more: a thread is safe here)
-                    batch = ("draw", raw, [todo[i].name for i in theirs])
-                    sender = threading.Thread(target=_send_quietly, args=(early.more, batch))
-                    sender.start()
-                    sent = True
-                elif queue:
-                    drawn.update(_draw(todo, [queue.pop(0)]))
-                else:  # idle while the drawer is still busy: its share is drawn here
-                    queue, theirs = list(theirs), []
-            if not sent:
-                _send_quietly(early.more, ("stop",))
-            if not done:
-                late = _reply(early) or {}
-                drawn.update({k: v for k, v in late.items() if k not in drawn})
-                taken |= set(late)
-            if sent:
-                drawn.update(_reply(early) or {})  # its share (a failure: drawn below)
-                if sender is not None:
-                    sender.join()  # done, or failed on a drawer that is gone
-            _close(early)
-        else:
-            groups = split_jobs(weights, processes) or [[]]
-            children = [_fork_drawer(todo, g) for g in groups[1:]]
-            drawn.update(_draw(todo, groups[0]))
-            for child in children:
-                pngs = _collect(child)
-                if pngs is None:
-                    raise RuntimeError("a drawing process failed")
-                drawn.update(pngs)
-        missing = [j for j in final if j.name not in drawn]
+        taken: set[str] = set()  # the figures taken from the early request
+        for (kind, i), png in queue.drawn.items():
+            if kind == "final":
+                drawn[final[i].name] = png
+            elif reuse:
+                drawn[queue.jobs["early"][i].name] = png
+                taken.add(queue.jobs["early"][i].name)
+        missing = [j for j in final if j.name not in drawn]  # a drawer failed: drawn here
         drawn.update(_draw(missing, range(len(missing))))
         pngs = {j.name: drawn[j.name] for j in final}
         extra = finish(payload, pngs) if finish is not None else {}
