@@ -122,29 +122,85 @@ def test_an_unexpected_artist_module_is_left_alone():
     assert Artist.__dict__["_update_set_signature_and_docstring"] is before
 
 
+KWDOC = r"""
+import json, sys
+from microg.cli._startup import install
+install()
+import matplotlib._docstring as md
+import matplotlib.axes as ma
+import matplotlib.patches as mp
+import matplotlib.lines as ml
+doc = ma.Axes.plot.__doc__ or ""
+missing = []
+for key in ("NoSuchKey", "x:kwdocs"):  # what is not a property table is still an error
+    try:
+        md.interpd.params[key]
+    except KeyError:
+        missing.append(key)
+line = ml.Line2D([0, 1], [0, 1], linewidth=2.5, color="red")
+patch = mp.Rectangle((0, 0), 1, 2, hatch="//")
+print(json.dumps({"plot": "Line2D" in doc and "antialiased" in doc, "doc": doc, "missing": missing,
+                  "line": [line.get_linewidth(), line.get_color()],
+                  "patch": [patch.get_hatch(), patch.get_height()]}))
+"""
+
+
+def test_matplotlib_docstrings_name_the_property_tables_and_artists_are_the_same():
+    lean, plain = _py(KWDOC), _py(KWDOC.replace("install()", "pass"))
+    assert plain["plot"] and not lean["plot"]  # the reference lists Line2D's properties
+    assert "(the properties of Line2D: ``matplotlib.artist.kwdoc``)" in lean["doc"]
+    assert lean["missing"] == plain["missing"] == ["NoSuchKey", "x:kwdocs"]
+    assert lean["line"] == plain["line"] and lean["patch"] == plain["patch"]
+
+
+def test_an_unexpected_docstring_module_is_left_alone():
+    from types import ModuleType
+
+    from microg.cli._startup import lean_kwdoc
+
+    assert lean_kwdoc(ModuleType("matplotlib._docstring")) is False  # no loader
+
+    class _ArtistKwdocLoader(dict):  # no __missing__ of its own: another mechanism
+        pass
+
+    mod = ModuleType("matplotlib._docstring")
+    mod._ArtistKwdocLoader = _ArtistKwdocLoader
+    mod.interpd = object()
+    assert lean_kwdoc(mod) is False
+    assert "__missing__" not in vars(_ArtistKwdocLoader)
+
+
 LAZY = r"""
 import json, sys, importlib.util
 from microg.cli._startup import LAZY, install
 install()
 import numpy, scipy.linalg
 lazy = {m: type(sys.modules[m]).__name__ for m in sorted(LAZY) if m in sys.modules}
+from microg.report.render import _warm_up
+_warm_up()  # a figure drawn, as the helpers do first (numpy.ma is used)
+lazy["fontTools.agl"] = type(sys.modules["fontTools.agl"]).__name__
 ok = numpy.testing.assert_allclose is not None  # loads on first use
 ma = float(numpy.ma.masked_invalid([1.0, numpy.nan]).sum())  # matplotlib's use, in the helpers
+import fontTools.agl
+glyph = fontTools.agl.toUnicode("uni0041")  # as dviread reads a TeX font's glyph names
 print(json.dumps({"lazy": lazy, "after": type(sys.modules["numpy.testing"]).__name__,
                   "ok": ok, "unittest": "unittest" in sys.modules, "ma": ma,
-                  "ma_after": type(sys.modules["numpy.ma"]).__name__}))
+                  "ma_after": type(sys.modules["numpy.ma"]).__name__, "glyph": glyph,
+                  "agl_after": type(sys.modules["fontTools.agl"]).__name__}))
 """
 
 
 def test_numpys_tool_submodules_load_on_first_use():
     out = _py(LAZY)
-    # scipy's array-API clone touched them all, and their code has not run
+    # scipy's array-API clone touched them all, matplotlib's Agg backend fontTools.agl,
+    # and their code has not run (a figure was drawn meanwhile)
     import microg.cli._startup as startup
 
     assert out["lazy"] == dict.fromkeys(sorted(startup.LAZY), "_LazyModule")
     assert out["ok"] and out["after"] == "module"  # a real module once used
     assert out["unittest"]  # numpy.testing's own imports ran when it was used
     assert out["ma"] == 1.0 and out["ma_after"] == "module"  # the masked sum: 1 + (masked)
+    assert out["glyph"] == "A" and out["agl_after"] == "module"  # fontTools' own answer
 
 
 SCIPY_DOCS = r"""
