@@ -302,3 +302,27 @@ def test_report_figures_keep_every_label_inside():
         if len(fig.axes) == 2:
             top, bottom = (a.get_tightbbox(renderer) for a in fig.axes)
             assert bottom.y1 <= top.y0 + 1
+
+
+def test_the_model_figure_draws_every_sample_of_every_component_once():
+    # reference: the structure's own sample positions; each component (beam, body) is one
+    # run of the line between NaN breaks, so no segment joins two components
+    import microg
+    from microg.plotting.analysis import _groups, _views, model_figure, sample_displacements
+
+    result = microg.analyze("ioc", observe=["lab"], duration=40, dt=0.02, isolation=False)
+    pos, _ = sample_displacements(result.structure, result.modes.phi[:, :1])
+    groups = [g for g in _groups(result.structure, pos.shape[0]) if g.size]
+    assert len(groups) > 1  # the IOC model has several components
+    fig = model_figure(result.structure, result.modes, {}, [])
+    for ax, (h, v) in zip(fig.axes[:2], _views(pos), strict=True):
+        line = ax.get_lines()[0]  # the model, drawn first
+        xy = np.column_stack([line.get_xdata(), line.get_ydata()])
+        runs = np.split(xy, np.flatnonzero(np.isnan(xy[:, 0])))
+        runs = [r[~np.isnan(r[:, 0])] for r in runs]
+        assert len(runs) == len(groups)
+        for run, g in zip(runs, groups, strict=True):
+            # the same points (sorted along the component), exactly: they are copied
+            got = np.unique(run, axis=0)
+            want = np.unique(pos[g][:, [h, v]], axis=0)
+            assert np.array_equal(got, want)

@@ -64,13 +64,18 @@ def _groups(structure: Structure, n: int) -> list[np.ndarray]:
 
 
 def _draw(ax: Any, pos: np.ndarray, groups: list[np.ndarray], h: int, v: int, **kw: Any) -> None:
+    """Each group drawn as a line along it (one line artist, broken by NaN between groups)."""
+    parts = []
     for g in groups:
         if g.size == 0:
             continue
         p = pos[g]
         axis = int(np.argmax(np.ptp(p, axis=0))) if g.size > 1 else 0
         order = np.argsort(p[:, axis], kind="stable")
-        ax.plot(p[order, h], p[order, v], **kw)
+        parts += [p[order][:, [h, v]], np.full((1, 2), np.nan)]
+    if parts:
+        xy = np.concatenate(parts[:-1])
+        ax.plot(xy[:, 0], xy[:, 1], **kw)
 
 
 def _views(pos: np.ndarray) -> list[tuple[int, int]]:
