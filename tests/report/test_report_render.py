@@ -16,7 +16,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from microg.report.render import FigureRenderer, default_processes, split_jobs
+from microg.report.render import FigureJob, FigureRenderer, _Queue, default_processes
 
 SCRIPT = r"""
 import json, os, sys, time
@@ -73,8 +73,23 @@ def pid_png():
     return str(os.getpid()).encode()
 
 
-def early_slow(payload):
-    return [FigureJob("e.png", 1.0, lambda: time.sleep(0.1) or pid_png())]
+import tempfile
+MARKS = tempfile.mkdtemp()
+
+
+def started(mark):  # the early drawer has begun its figure (mark: a file name, or None)
+    if mark:
+        open(os.path.join(MARKS, mark), "w").close()
+
+
+def wait_started(mark):  # until the early drawer has begun mark's figure (at most 60 s)
+    deadline = time.monotonic() + 60
+    while not os.path.exists(os.path.join(MARKS, mark)) and time.monotonic() < deadline:
+        time.sleep(0.005)
+
+
+def early_slow(mark):
+    return [FigureJob("e.png", 1.0, lambda: started(mark) or time.sleep(0.1) or pid_png())]
 
 
 def final_two(payload):
@@ -83,13 +98,14 @@ def final_two(payload):
 
 
 r = FigureRenderer.start((), processes=2)
-r.draw_early(early_slow, 1)  # still drawing when the final request comes, done before a.png
+r.draw_early(early_slow, "shared")  # still drawing when the final request comes
+wait_started("shared")
 shared = r.render(final_two, 1, reuse_early=True)
 out["early_shared"] = {k: int(v) for k, v in shared.items()} if shared else r.error
 
 
-def early_busy(payload):
-    return [FigureJob("e.png", 1.0, lambda: time.sleep(0.5) or pid_png())]
+def early_busy(mark):
+    return [FigureJob("e.png", 1.0, lambda: started(mark) or time.sleep(0.5) or pid_png())]
 
 
 def final_quick(payload):
@@ -97,7 +113,7 @@ def final_quick(payload):
 
 
 r = FigureRenderer.start((), processes=2)
-r.draw_early(early_busy, 1)  # busy until after the helper has drawn its share
+r.draw_early(early_busy, None)  # busy until after the helper has drawn its share
 shared = r.render(final_quick, 1, reuse_early=True)
 out["early_busy"] = {k: int(v) for k, v in shared.items()} if shared else r.error
 
@@ -119,18 +135,44 @@ def final_weighted(payload):
 
 
 r = FigureRenderer.start((), processes=2)
-r.draw_early(early_slow, 1)
+r.draw_early(early_slow, "uneven")
+wait_started("uneven")
 shared = r.render(final_uneven, 1, reuse_early=True)
 out["early_uneven"] = {k: v.decode().split() for k, v in shared.items()} if shared else r.error
 r = FigureRenderer.start((), processes=2)
-r.draw_early(early_busy, 1)  # busy throughout: the helper draws a, b and c, heaviest first
-time.sleep(0.2)  # the early drawer has taken e.png
+r.draw_early(early_busy, "weighted")  # busy throughout: the helper draws a, b, c
+wait_started("weighted")
 shared = r.render(final_weighted, 1, reuse_early=True)
 out["early_weighted"] = {k: v.decode().split() for k, v in shared.items()} if shared else r.error
+def early_unwanted(mark):
+    return [FigureJob("x.png", 1.0, lambda: started(mark) or time.sleep(1.5) or b"x")]
+
+
+def early_hung(mark):
+    return [FigureJob("a.png", 1.0, lambda: started(mark) or time.sleep(30) or b"late a")]
+
+
+for reuse in (True, False):  # an early figure the reply does not use is not waited for
+    r = FigureRenderer.start((), processes=2)
+    r.draw_early(early_unwanted, f"unwanted{reuse}")
+    wait_started(f"unwanted{reuse}")
+    t = time.monotonic()
+    got = r.render(one, 1, reuse_early=reuse)
+    out[f"early_unwanted_{reuse}"] = [got and sorted(got), time.monotonic() - t]
+import microg.report.render as render_module
+render_module.DRAWER_TIMEOUT_S = 1.0
+r = FigureRenderer.start((), processes=2)
+r.draw_early(early_hung, "hung")  # a drawer that never answers is given up
+wait_started("hung")
+t = time.monotonic()
+got = r.render(one, 1, reuse_early=True)
+out["early_hung"] = [got and {k: v.decode() for k, v in got.items()}, time.monotonic() - t,
+                     r.early_used]
+render_module.DRAWER_TIMEOUT_S = render_module.TIMEOUT_S / 3
 r = FigureRenderer.start((), processes=2)
 r.draw_early(early, 1)
 time.sleep(0.5)  # done before the final request comes
-shared = r.render(final_two, 1)  # not reused: the early drawer is stopped, all drawn again
+shared = r.render(final_two, 1)  # not reused: all are drawn again from the final request
 out["early_not_reused"] = {k: int(v) for k, v in shared.items()} if shared else r.error
 r = FigureRenderer.start((), processes=2)
 r.draw_early(early_failing, 1)
@@ -300,6 +342,21 @@ def test_the_heaviest_job_is_taken_first(forked):
     assert order == ["b", "c", "a"]  # weights 3, 2, 1
 
 
+def test_the_reply_does_not_wait_for_an_early_figure_it_does_not_use(forked):
+    # x.png (1.5 s) is not a final job; the final ones take no time
+    for reuse in (True, False):
+        names, seconds = forked[f"early_unwanted_{reuse}"]
+        assert names == ["a.png", "b.png"] and seconds < 1.0, (reuse, seconds)
+
+
+def test_a_drawer_that_never_answers_is_given_up(forked):
+    # its early a.png sleeps 30 s; after DRAWER_TIMEOUT_S (1 s here) the helper draws the
+    # final a.png itself and replies
+    pngs, seconds, used = forked["early_hung"]
+    assert pngs == {"a.png": "a", "b.png": "b"} and used == []
+    assert 1.0 <= seconds < 10.0
+
+
 def test_early_figures_of_another_analysis_are_not_used(forked):
     # an early request made from another run's modes: everything is drawn again, and the
     # files are the in-process ones of the result asked for (its modes.png differs)
@@ -360,15 +417,31 @@ def test_one_process_starts_no_helper(monkeypatch):
     assert default_processes() == 1
 
 
-@given(st.lists(st.floats(0.01, 10.0), min_size=1, max_size=30), st.integers(1, 4))
-def test_split_jobs_is_a_balanced_partition(weights, parts):
-    groups = split_jobs(weights, parts)
-    flat = sorted(i for g in groups for i in g)
-    assert flat == list(range(len(weights)))  # every job exactly once
-    assert len(groups) <= parts and all(g == sorted(g) for g in groups)
-    # Graham's bound for list scheduling: no group exceeds the mean load by more than one job
-    loads = [sum(weights[i] for i in g) for g in groups]
-    assert max(loads) <= sum(weights) / parts + max(weights) + 1e-9
+_NAMES = st.sampled_from("abcdefgh")
+_JOBS = st.lists(st.tuples(_NAMES, st.floats(0.1, 5.0)), max_size=6, unique_by=lambda t: t[0])
+
+
+@given(_JOBS, _JOBS.filter(bool), st.booleans(), st.integers(0, 6), st.integers(1, 3))
+def test_the_queue_draws_each_final_figure_once_heaviest_first(early, final, reuse, ahead, n):
+    # reference: the request's own list of jobs.  ``ahead`` early jobs are taken before the
+    # final request comes, then ``n`` processes take turns until nothing is left
+    q = _Queue([FigureJob(name, w, bytes) for name, w in early])
+    drawn = [q.take(1) for _ in range(min(ahead, len(early)))]
+    q.set_final([FigureJob(name, w, bytes) for name, w in final], b"", reuse)
+    after = []
+    while (job := q.take(len(after) % n)) is not None:
+        after.append(job)
+    weights = [q.jobs[k][i].weight for k, i in after]
+    assert weights == sorted(weights, reverse=True)  # the heaviest first
+    # every final figure exactly once: drawn from the final request, or (reuse) early
+    got = [q.jobs["final"][i].name for k, i in after if k == "final"]
+    if reuse:
+        got += [q.jobs["early"][i].name for k, i in drawn + after if k == "early"]
+        got = [name for name in got if name in dict(final)]
+    else:
+        assert all(k == "final" for k, _ in after)  # no early figure is drawn any more
+    assert sorted(got) == sorted(dict(final))
+    assert all(q.wanted(job) == (job[0] == "final" or reuse) for job in after)
 
 
 DECK = r"""

@@ -59,13 +59,17 @@ from microg._fork import (
     write_all,
 )
 
-__all__ = ["FigureJob", "FigureRenderer", "Omitted", "default_processes", "split_jobs"]
+__all__ = ["FigureJob", "FigureRenderer", "Omitted", "default_processes"]
 
 #: drawing processes at most (the machine this is tuned for has two cores)
 MAX_PROCESSES = 2
 
 #: seconds a helper may take before the caller gives up on it and draws in-process
 TIMEOUT_S = 600.0
+
+#: seconds the helper waits for a drawing process's figure before it stops that process and
+#: draws the figure itself (well within the caller's :data:`TIMEOUT_S`)
+DRAWER_TIMEOUT_S = TIMEOUT_S / 3
 
 #: a pickled request larger than this is drawn in-process instead (bytes)
 MAX_PAYLOAD_BYTES = 64_000_000
@@ -78,8 +82,8 @@ _PR_SET_PDEATHSIG = 1
 class FigureJob:
     """One figure of a report: its file name, a relative cost, and how to draw it.
 
-    ``draw`` returns PNG bytes; ``weight`` is only used to share the figures out evenly
-    between the drawing processes.
+    ``draw`` returns PNG bytes; ``weight`` is only used to order the jobs (the heaviest is
+    drawn first, so the drawing processes finish close together).
     """
 
     name: str
@@ -96,27 +100,6 @@ def default_processes() -> int:
         except ValueError:
             return 1
     return max(1, min(MAX_PROCESSES, usable_cpus()))
-
-
-def split_jobs(
-    weights: Sequence[float], parts: int, loads: Sequence[float] | None = None
-) -> list[list[int]]:
-    """Indices of ``weights`` shared into ``parts`` groups of nearly equal total weight.
-
-    Longest first, each into the lightest group so far (the LPT rule), counting the work
-    each group has already (``loads``, default none); each group keeps the order of the
-    input.  Without ``loads`` the empty groups are dropped; with them the groups keep their
-    places (group k is the one that had ``loads[k]``).
-    """
-    n = max(1, parts) if loads is None else len(loads)
-    groups: list[list[int]] = [[] for _ in range(n)]
-    load = [0.0] * n if loads is None else [float(x) for x in loads]
-    for i in sorted(range(len(weights)), key=lambda k: -weights[k]):
-        g = min(range(n), key=lambda k: load[k])
-        groups[g].append(i)
-        load[g] += weights[i]
-    out = [sorted(g) for g in groups]
-    return out if loads is not None else [g for g in out if g]
 
 
 # ----------------------------------------------------------------------------- helper side
@@ -176,15 +159,20 @@ class _Drawer:
     has_final: bool = False
 
 
-def _fork_drawer(early: Sequence[FigureJob], final: Sequence[FigureJob] | None) -> _Drawer:
+def _fork_drawer(
+    early: Sequence[FigureJob],
+    final: Sequence[FigureJob] | None,
+    siblings: Sequence[_Drawer] = (),
+) -> _Drawer:
     """Fork a process that draws, one at a time, the jobs the helper hands it.
 
     It asks for a job (``("next",)``, then with each PNG ``("png", kind, index, bytes)``) and
-    is answered ``(kind, index, request)``: ``early[index]``, or with kind ``"final"`` the
-    final job ``index``, the final jobs made the first time from ``request`` (the final
+    is answered ``(kind, index, name, request)``: ``early[index]``, or with kind ``"final"``
+    the final job ``index``, the final jobs made the first time from ``request`` (the final
     request as the helper received it, pickled) when it was forked before them (``final``
-    None); anything else stops it.  It dies with the helper (killed when its caller fails):
-    nothing is left drawing.
+    None); a job not named ``name`` is an error, anything else stops it.  It dies with the
+    helper (killed when its caller fails): nothing is left drawing.  The helper's ends of
+    the pipes of ``siblings`` (drawing processes forked before) are closed in it.
     """
     r, w = pipe()
     orders_r, orders_w = pipe()
@@ -193,8 +181,8 @@ def _fork_drawer(early: Sequence[FigureJob], final: Sequence[FigureJob] | None) 
     if pid == 0:  # the drawing process
         code = 0
         try:
-            os.close(r)
-            os.close(orders_w)
+            for fd in (r, orders_w, *(f for d in siblings for f in (d.replies, d.orders))):
+                os.close(fd)
             _die_with(parent)
             jobs: dict[str, list[FigureJob] | None] = {
                 "early": list(early),
@@ -206,11 +194,13 @@ def _fork_drawer(early: Sequence[FigureJob], final: Sequence[FigureJob] | None) 
                 order = receive(orders_r)
                 if not isinstance(order, tuple) or order[0] not in jobs:
                     break
-                kind, index, request = order
+                kind, index, name, request = order
                 todo = jobs[kind]
                 if todo is None:
                     _, make_jobs, payload, *_ = pickle.loads(request)
                     todo = jobs[kind] = make_jobs(payload)
+                if todo[index].name != name:
+                    raise RuntimeError(f"job {index} is {todo[index].name!r}, not {name!r}")
                 reply = ("png", kind, index, _draw(todo, [index], parent).popitem()[1])
         except BaseException:
             code = 1
@@ -222,12 +212,11 @@ def _fork_drawer(early: Sequence[FigureJob], final: Sequence[FigureJob] | None) 
 
 
 def _close(drawer: _Drawer) -> None:
-    """Release a drawing process's pipes and reap it (it has stopped, or is told to)."""
+    """Release a drawing process's pipes and reap it (killed if it has not stopped)."""
     for fd in (drawer.replies, drawer.orders):
         with contextlib.suppress(OSError):
             os.close(fd)
-    with contextlib.suppress(ChildProcessError):
-        os.waitpid(drawer.pid, 0)
+    stop(drawer.pid)
 
 
 class _Queue:
@@ -247,6 +236,8 @@ class _Queue:
         self.busy: dict[int, tuple[str, int] | None] = {}  # drawer pid -> its job
         self.final_request: bytes | None = None  # the pickled final request, once it came
         self.closed = False  # no more jobs will come: a free drawer stops
+        self.reuse = False  # whether the final request takes early figures
+        self.final_names: set[str] = set()
 
     def _heaviest_first(self, kind: str, which: Any) -> list[tuple[str, int]]:
         jobs = self.jobs[kind]
@@ -269,8 +260,16 @@ class _Queue:
                 key=lambda t: -self.jobs[t[0]][t[1]].weight,
             )
             self.final_request = raw
+            self.reuse, self.final_names = reuse, names
             self.closed = True
             self.cond.notify_all()
+
+    def wanted(self, job: tuple[str, int] | None) -> bool:
+        """Whether the final reply needs ``job``'s figure (an early one it does not: no)."""
+        if job is None:
+            return False
+        kind, i = job
+        return kind == "final" or (self.reuse and self.jobs["early"][i].name in self.final_names)
 
     def take(self, pid: int) -> tuple[str, int] | None:
         """The next job for ``pid`` (0: the helper); None when none is left."""
@@ -295,9 +294,9 @@ class _Queue:
         job: tuple[str, int] | None = None
         try:
             while True:
-                reply = receive(drawer.replies, time.monotonic() + TIMEOUT_S, drawer.pid)
+                reply = receive(drawer.replies, time.monotonic() + DRAWER_TIMEOUT_S, drawer.pid)
                 if not isinstance(reply, tuple):
-                    break  # it died (its job is drawn by the helper)
+                    break  # it died or hangs (its job is drawn by the helper)
                 if reply[0] == "png":
                     self.done(drawer.pid, (reply[1], reply[2]), reply[3])
                 job = self.take(drawer.pid)
@@ -306,7 +305,7 @@ class _Queue:
                 request = None
                 if job[0] == "final" and not sent_final:
                     request, sent_final = self.final_request, True
-                send(drawer.orders, (*job, request))
+                send(drawer.orders, (*job, self.jobs[job[0]][job[1]].name, request))
         except BaseException:  # a drawer that is gone: what it held is drawn by the helper
             pass
         finally:
@@ -314,14 +313,24 @@ class _Queue:
                 send(drawer.orders, ("stop",))
             self.done(drawer.pid, None, None)
 
-    def wait_idle(self, idle: Callable[[], None]) -> None:
-        """Return when no drawing process holds a job; ``idle()`` runs first if one does."""
+    def wait_idle(self, idle: Callable[[], None]) -> list[int]:
+        """Wait until no drawing process holds a wanted job; those holding another job.
+
+        ``idle()`` runs first if one holds a wanted job.  A drawing process that does not
+        answer within :data:`DRAWER_TIMEOUT_S` is given up (its figure is drawn here).
+        """
+
+        def left() -> bool:
+            return any(self.wanted(job) for pid, job in self.busy.items() if pid)
+
         with self.cond:
-            if not any(self.busy.values()):
-                return
-        idle()
+            need = left()
+        if need:
+            idle()
+            with self.cond:
+                self.cond.wait_for(lambda: not left(), DRAWER_TIMEOUT_S + 1.0)
         with self.cond:
-            self.cond.wait_for(lambda: not any(self.busy.values()), TIMEOUT_S)
+            return [pid for pid, job in self.busy.items() if pid and job is not None]
 
 
 def _serve(queue: _Queue, drawer: _Drawer) -> threading.Thread:
@@ -401,7 +410,8 @@ def _helper(
                         servers = [_serve(queue, drawers[0])]
         if queue is None:  # no early request: drawing processes for the final jobs
             queue = _Queue([])
-            drawers = [_fork_drawer([], final) for _ in range(processes - 1)]
+            for _ in range(processes - 1):
+                drawers.append(_fork_drawer([], final, drawers))
             servers = [_serve(queue, d) for d in drawers]  # threads once all are forked
         queue.set_final(final, final_raw, bool(reuse))
         # a drawing process waiting for its next job waits for the GIL of this one, which
@@ -416,9 +426,13 @@ def _helper(
                     raise
                 # an early job that fails is drawn again from the final request below
             queue.done(0, job, png)
-        queue.wait_idle(warm_now)  # the warm step while the last figures are drawn
+        # the warm step (for the finish step) while the last figures are drawn
+        unwanted = queue.wait_idle(warm_now if finish is not None else lambda: None)
+        for pid in unwanted:  # drawing an early figure the reply does not use
+            with contextlib.suppress(ProcessLookupError):
+                os.kill(pid, signal.SIGKILL)
         for server in servers:
-            server.join(TIMEOUT_S)
+            server.join(DRAWER_TIMEOUT_S + 1.0)
         for drawer in drawers:
             _close(drawer)
         drawn: dict[str, bytes] = {}
