@@ -277,6 +277,50 @@ print(json.dumps(out))
 """
 
 
+GC = r"""
+import gc, json, sys
+from microg.cli._startup import install
+if sys.argv[1] == "process":
+    install()
+start = gc.get_stats()[0]["collections"]
+import numpy, scipy.linalg, microg.models.schema  # what a command imports first
+before = [s["collections"] for s in gc.get_stats()]
+class Node:
+    pass
+for _ in range(300_000):  # cyclic garbage, freed by the collector alone
+    a, b = Node(), Node()
+    a.other, b.other = b, a
+after = [s["collections"] for s in gc.get_stats()]
+print(json.dumps({"threshold": gc.get_threshold(), "enabled": gc.isenabled(),
+                  "import_collections": before[0] - start, "new": after[0] - before[0],
+                  "left": sum(type(o) is Node for o in gc.get_objects())}))
+"""
+
+
+def _gc(kind: str) -> dict:
+    proc = subprocess.run(
+        [sys.executable, "-c", GC, kind],
+        capture_output=True,
+        text=True,
+        env=_env(),
+        timeout=300,
+        check=True,
+    )
+    return json.loads(proc.stdout.strip().splitlines()[-1])
+
+
+def test_the_collector_skips_the_imports_and_still_frees_cycles():
+    from microg.cli._startup import GC_THRESHOLD
+
+    plain, process = _gc("plain"), _gc("process")
+    assert plain["threshold"][0] == 700 and plain["import_collections"] > 50  # the reference
+    assert process["threshold"] == [GC_THRESHOLD, *plain["threshold"][1:]]
+    assert process["enabled"] and process["import_collections"] <= 1  # at most one
+    # 600,000 objects in cycles: the collector ran, and at most a threshold's worth is left
+    # (with the collector off all 600,000 would be)
+    assert process["new"] >= 3 and process["left"] <= GC_THRESHOLD
+
+
 def test_blas_starts_on_one_thread_and_large_problems_get_the_cores():
     out = _py(BLAS)
     assert out["start"] == [1] and out["small"] == [1] and out["after"] == [1]
