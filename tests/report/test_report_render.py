@@ -32,7 +32,11 @@ def probe(payload):
 
 
 out = {}
+rep.start_renderer(processes=1).close()  # no helper: nothing imported for it
+out["shared_none"] = "microg.structure.fem" in sys.modules
 prober = rep.start_renderer(processes=2)  # started before the caller imports scipy, pydantic
+out["shared_after"] = [type(sys.modules["numpy.ma"]).__name__,
+                       all(m in sys.modules for m in rep.SHARED), "scipy" in sys.modules]
 with rep.start_renderer(processes=2) as renderer:  # started before the computation
     out["active"] = renderer.active
     # the model's figures start once the modes are solved, the rest with the result
@@ -372,6 +376,13 @@ def test_no_drawing_process_outlives_its_helper(forked):
 def test_a_large_early_request_is_refused_once(forked):
     # refused for its size; the final request is then not even tried (drawn in-process)
     assert forked["large_early"] == [False, None, True]
+
+
+def test_what_both_processes_use_is_imported_once_before_the_fork(forked):
+    # nothing for a renderer that starts no helper; with one, SHARED (numpy.ma run for
+    # real, not a lazy stand-in) and still no scipy
+    assert forked["shared_none"] is False
+    assert forked["shared_after"] == ["module", True, False]
 
 
 def test_the_helper_unpickles_an_analysis_without_scipy(forked):

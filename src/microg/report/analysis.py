@@ -16,6 +16,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "PRELOAD",
+    "SHARED",
     "UNPICKLE",
     "early_figures",
     "figure_jobs",
@@ -321,6 +322,12 @@ PRELOAD = (
 #: imported yet.  None of them loads scipy (the matrices are omitted: :func:`_unread`)
 UNPICKLE = ("microg.structure.fem", "microg.structure.frame")
 
+#: ... and what the caller imports before the fork, because both processes use it: a
+#: station's frame model (discretising it, and unpickling its structure), numpy's masked
+#: arrays (matplotlib draws through them; ``numpy.unique`` loads them) and logging (~0.05 s
+#: that each process would otherwise pay)
+SHARED = ("logging", "numpy.ma", "microg.structure.fem", "microg.structure.frame")
+
 
 def _unread(structure: Any) -> Callable[[object], bool]:
     """What a figure request omits: the structure's mass and stiffness matrices.
@@ -355,7 +362,9 @@ def start_renderer(processes: int | None = None) -> FigureRenderer:
     """
     from microg.report.render import FigureRenderer
 
-    return FigureRenderer.start(PRELOAD, processes, then=UNPICKLE, warm=_analysis_template)
+    return FigureRenderer.start(
+        PRELOAD, processes, then=UNPICKLE, warm=_analysis_template, shared=SHARED
+    )
 
 
 @lru_cache(maxsize=1)

@@ -546,6 +546,7 @@ class FigureRenderer:
         processes: int | None = None,
         then: Sequence[str] = (),
         warm: Callable[[], object] | None = None,
+        shared: Sequence[str] = (),
     ) -> FigureRenderer:
         """Fork the helper now, which imports ``preload`` (module names) and waits.
 
@@ -561,10 +562,17 @@ class FigureRenderer:
         warm : callable, optional
             Called in the helper after those imports, when no request waits (e.g. loading
             a template that a ``finish`` step uses); its errors are ignored.
+        shared : sequence of str
+            Modules that both the caller and the helper will use: imported here, before
+            the fork, so that the two processes pay for them once (a module that this
+            process loads lazily is executed now).  Only when a helper starts.
         """
         n = default_processes() if processes is None else max(1, int(processes))
         if n < 2 or not can_fork():
             return cls(None, None, None)  # draw in-process
+        for name in shared:
+            module = importlib.import_module(name)
+            getattr(module, "__name__", None)  # a lazily loaded module runs its code now
         req_r, req_w = pipe()
         rep_r, rep_w = pipe()
         try:
