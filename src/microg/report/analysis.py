@@ -324,9 +324,21 @@ UNPICKLE = ("microg.structure.fem", "microg.structure.frame")
 
 #: ... and what the caller imports before the fork, because both processes use it: a
 #: station's frame model (discretising it, and unpickling its structure), numpy's masked
-#: arrays (matplotlib draws through them; ``numpy.unique`` loads them) and logging (~0.05 s
-#: that each process would otherwise pay)
-SHARED = ("logging", "numpy.ma", "microg.structure.fem", "microg.structure.frame")
+#: arrays (matplotlib draws through them; ``numpy.unique`` loads them), and the standard
+#: modules that pydantic and scipy import in the caller and matplotlib in the helper
+#: (~0.06 s that each process would otherwise pay)
+SHARED = (
+    "logging",
+    "subprocess",
+    "socket",
+    "decimal",
+    "fractions",
+    "zoneinfo",
+    "calendar",
+    "numpy.ma",
+    "microg.structure.fem",
+    "microg.structure.frame",
+)
 
 
 def _unread(structure: Any) -> Callable[[object], bool]:
