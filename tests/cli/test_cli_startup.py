@@ -25,9 +25,9 @@ def _env(**extra: str) -> dict[str, str]:
     return env
 
 
-def _py(code: str, **env: str) -> dict:
+def _py(code: str, *args: str, **env: str) -> dict:
     proc = subprocess.run(
-        [sys.executable, "-c", code],
+        [sys.executable, "-c", code, *args],
         capture_output=True,
         text=True,
         env=_env(**env),
@@ -219,20 +219,8 @@ print(json.dumps({"scraper": util.FunctionDoc.__name__, "eigh_doc": sla.eigh.__d
 """
 
 
-def _scipy_docs(kind: str) -> dict:
-    proc = subprocess.run(
-        [sys.executable, "-c", SCIPY_DOCS, kind],
-        capture_output=True,
-        text=True,
-        env=_env(),
-        timeout=300,
-        check=True,
-    )
-    return json.loads(proc.stdout.strip().splitlines()[-1])
-
-
 def test_scipys_batch_docstrings_are_not_parsed_and_the_functions_are_the_same():
-    lean, plain = _scipy_docs("lean"), _scipy_docs("plain")
+    lean, plain = _py(SCIPY_DOCS, "lean"), _py(SCIPY_DOCS, "plain")
     assert plain["scraper"] == "FunctionDoc"  # the reference: scipy's own
     assert lean["scraper"] == "_LeanFunctionDoc"
     assert lean["w"] == plain["w"]  # the batched call, bit for bit (JSON floats round-trip)
@@ -297,22 +285,10 @@ print(json.dumps({"threshold": gc.get_threshold(), "enabled": gc.isenabled(),
 """
 
 
-def _gc(kind: str) -> dict:
-    proc = subprocess.run(
-        [sys.executable, "-c", GC, kind],
-        capture_output=True,
-        text=True,
-        env=_env(),
-        timeout=300,
-        check=True,
-    )
-    return json.loads(proc.stdout.strip().splitlines()[-1])
-
-
 def test_the_collector_skips_the_imports_and_still_frees_cycles():
     from microg.cli._startup import GC_THRESHOLD
 
-    plain, process = _gc("plain"), _gc("process")
+    plain, process = _py(GC, "plain"), _py(GC, "process")
     assert plain["threshold"][0] == 700 and plain["import_collections"] > 50  # the reference
     assert process["threshold"] == [GC_THRESHOLD, *plain["threshold"][1:]]
     assert process["enabled"] and process["import_collections"] <= 1  # at most one
