@@ -21,7 +21,7 @@ Every baseline has ARPACK's default basis (``ncv = 2k + 1``), a negative shift
 microg's time over the fastest baseline.  (microg picks its own BLAS thread count inside
 ``solve_modes``; the thread setting applies to the baselines, and is the ceiling for microg.)
 Run: ``.venv/bin/python benchmarks/bench_modes.py`` (the 103k-DOF model, 30 modes, one
-thread: under a minute); the full table of the issue is
+thread: under a minute); the full table is
 ``.venv/bin/python benchmarks/bench_modes.py --modes 30 300 --threads 1 2`` (about 15 minutes
 on the 2-core machine: the 300-mode runs are dominated by ARPACK's orthogonalisation).
 """

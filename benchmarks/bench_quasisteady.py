@@ -1,4 +1,4 @@
-"""Benchmark: the quasi-steady map over 10^5 points (issue 12: vectorised, under 0.1 s).
+"""Benchmark: the quasi-steady map over 10^5 points.
 
 The peak quasi-steady magnitude over one orbit (180 samples; LVLH hold; drag from NRLMSIS
 2.1 with B = 100 kg/m^2) at 10^5 random points within 100 m of the shipped IOC model's centre

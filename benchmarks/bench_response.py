@@ -1,6 +1,6 @@
 """Benchmark: exact modal response (microg.dynamics.response) against strong baselines, same run.
 
-Problem (issue 10 section 6): 100 modes (6 rigid, omega = 0; 94 elastic, 0.1-40 Hz, zeta 0 to
+Problem: 100 modes (6 rigid, omega = 0; 94 elastic, 0.1-40 Hz, zeta 0 to
 0.02), 20,001 output times over 0-200 s, the report's crew push-off (Eq. 2.16: f0 = 25 lbf =
 111.2 N, t1 = 1 s, t13 = 13 s, t14 = 14 s), random mode shapes and three observed points.
 
@@ -10,7 +10,7 @@ Baselines, timed in the same process:
   time to output time with the exact step functions g, h, S, R of the elapsed time (computed once
   per distinct step length), splitting a step at every force breakpoint inside it.  This is the
   fastest way to get the same exact values on any grid; single-threaded, like microg's 1-thread
-  figures.  The aim (issue 10) is microg within 1.5x of it.
+  figures.  The aim is microg within 1.5x of it.
 * scipy.signal.lsim on ONE block-diagonal state-space system of all modes (200 states), the
   best lsim can do (per-mode calls are ~30 times slower).  lsim interpolates the input linearly
   between samples, so for the agreement check both solvers get the push-off as lsim sees it.
@@ -19,7 +19,7 @@ Baselines, timed in the same process:
 Grids: the uniform 0.01 s grid; a piecewise-uniform grid (0.01 s to 50 s, 0.02 s to 200 s, with
 the force breakpoints inserted: every uniform piece of each force segment takes the table path);
 and the uniform grid with the landing jump off the grid (t13 = 13.000000001 s), for the response
-and the exact peak (issue 9).  BLAS is limited to 1 thread for the
+and the exact peak.  BLAS is limited to 1 thread for the
 comparisons (2-thread figures printed beside them: on 2 cores they are often slower).  The
 "memory floor" rows time allocating and writing an output array of the same size: on this
 kind of machine, first-touch page faults of arrays above glibc's 32 MB mmap threshold cost as

@@ -118,7 +118,7 @@ def test_contract_and_compliance_fields(station) -> None:
         assert o["complies"] == bool(np.all(ok) and resolved.any())
 
 
-# ------------------------------------------------------------------ the public API (issue 8)
+# ------------------------------------------------------------------ the public API
 
 
 @pytest.fixture(scope="module")
@@ -163,8 +163,8 @@ def test_peak_is_exact_and_the_modes_sum_to_it(default_result) -> None:
         assert np.all(c.own_peak_g >= 0) and c.mode.min() >= 1
 
 
-def test_peak_between_samples_issue9(station) -> None:
-    # issue 9: a jump at 13.000000001 s, off the 0.01-s grid, must give the same peak as the
+def test_peak_between_samples(station) -> None:
+    # a jump at 13.000000001 s, off the 0.01-s grid, must give the same peak as the
     # jump on the grid (the sampled peak drops ~1 %); exact peaks agree to 1e-6
     import microg
     from microg.dynamics.forces import piecewise_linear
@@ -195,7 +195,7 @@ def test_several_forces_superpose(station) -> None:
     assert np.max(np.abs(a - ref)) <= 1e-12 * np.max(np.abs(ref))
 
 
-# ----------------------------------------------------- verdicts without warnings (issue 9 §2)
+# ----------------------------------------------------- verdicts without warnings
 
 
 def test_force_that_does_not_end_at_zero_warns(station) -> None:
@@ -443,7 +443,7 @@ def test_no_mode_in_the_response_is_refused_not_a_green_verdict():
     # the response would be identically zero, and "complies" would rest on nothing
     import microg
 
-    path = Path(__file__).parent / "data" / "nastran" / "beam_modes_m2.op2"
+    path = Path(__file__).parent / "data" / "nastran" / "beam_modes" / "beam_modes_m2.op2"
     model = microg.load_model(path, units="in,lbf,s")
     with pytest.raises(microg.InputError, match="no mode enters the response") as err:
         microg.analyze(model, force="crew-pushoff", at="grid:11", observe=["grid:6"])

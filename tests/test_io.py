@@ -1,6 +1,6 @@
 """Output helpers: run directories written as a whole, single files, file names, JSON.
 
-The run-directory tests reproduce issue 10 section 5: a kill mid-run must leave the previous
+The run-directory tests check that a kill mid-run leaves the previous
 run or the new one, never a mix; disk full and errors leave the previous run; stale figures
 disappear; a directory microg did not write is never replaced; point names that collide
 after sanitising get distinct files.
@@ -56,7 +56,7 @@ def test_run_directory_is_replaced_whole_and_stale_figures_go(tmp_path: Path) ->
     out = tmp_path / "run"
     write_run_directory(out, {"report.html": "old", "lab-isolated.png": b"old"}, where="out")
     assert _listing(out) == [RUN_MARKER, "lab-isolated.png", "report.html"]
-    # the next run needs no isolation: its directory has no lab-isolated.png (issue 10 sec. 5)
+    # the next run needs no isolation: its directory has no lab-isolated.png
     write_run_directory(out, {"report.html": "new", "results.json": "{}"}, where="out")
     assert _listing(out) == [RUN_MARKER, "report.html", "results.json"]
     assert (out / "report.html").read_text() == "new"
@@ -213,7 +213,7 @@ def _check_complete(out: Path) -> int | None:
 
 @pytest.mark.slow
 def test_killed_at_random_points_leaves_one_complete_run(tmp_path: Path) -> None:
-    # issue 10 sec. 5: kills mixed runs (8 of 20 trials) and left temporaries (33 of 76)
+    # kills mixed runs (8 of 20 trials) and left temporaries (33 of 76)
     out = tmp_path / "run"
     rng = random.Random(20261201)  # fixed seed: reproducible kill times
     last = None

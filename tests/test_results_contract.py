@@ -1,4 +1,4 @@
-"""The results contract (issue 8, item 4): every public result type has ``to_dict()`` that is
+"""The results contract: every public result type has ``to_dict()`` that is
 JSON-ready through ``microg._io.dumps``, and where it applies ``to_xarray()`` with a ``units``
 attribute on every data variable and coordinate, and ``.plot()`` returning a
 ``matplotlib.figure.Figure`` whose drawn data are the result's own numbers.

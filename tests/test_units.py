@@ -2,8 +2,8 @@
 
 References: the exact definitions of the US units (NIST SP 811: 1 ft = 0.3048 m,
 1 lb = 0.45359237 kg, g0 = 9.80665 m/s^2, so 1 lbf = 4.4482216152605 N) and 2 pi rad per
-cycle, written out here, never read back from pint.  The issue-10 reproductions are named
-after the string they feed.
+cycle, written out here, never read back from pint.  The reproductions of bad strings are
+named after the string they feed.
 """
 
 from __future__ import annotations
@@ -188,7 +188,7 @@ def test_physical_limits() -> None:
 
 
 def test_import_does_not_load_pint() -> None:
-    # issue 8: `import microg.units` must not import pint (about 1 s with its registry); the
+    # `import microg.units` must not import pint (about 1 s with its registry); the
     # common units come from the built-in table, and pint only for another name
     code = (
         "import sys, microg.units as u; assert 'pint' not in sys.modules; "

@@ -1000,7 +1000,7 @@ def _modal_accel_at(
 
 
 def _with_exact_peak(a: Assessment, peak: PeakResponse, req: Requirement) -> Assessment:
-    """The assessment with its peaks replaced by the certified exact ones (issue 9 section 1).
+    """The assessment with its peaks replaced by the certified exact ones.
 
     The exact peak is at least the sampled one, so a verdict that passed a peak limit on the
     samples is re-judged on the exact value.
@@ -1121,7 +1121,7 @@ def _intervals(t: np.ndarray, accel: np.ndarray, req: Requirement) -> dict[str, 
 class _Provenance:
     """The provenance record of a run, its model file hashed in a background thread.
 
-    A modal model's file can be hundreds of MB (issue 11: 193 MB for 20,000 grids x 200
+    A modal model's file can be hundreds of MB (193 MB for 20,000 grids x 200
     modes), a quarter of a second of SHA-256; hashlib and file reads release the GIL, so the
     hash runs beside the computation instead of after it.  :meth:`result` joins the thread
     and re-raises anything it raised.
@@ -1246,7 +1246,7 @@ def run_analysis(
         warnings += _check_modes_used(modes, np.asarray(elastic, bool), used, opts.max_freq_hz)
         # the transient's products contract over the modes (a few hundred): small GEMMs, on
         # one BLAS thread (two contend with each other and with the provenance hash: the
-        # issue-11 benchmark's point projections take 0.045 s on one, 0.08-0.15 s on two)
+        # modal-model benchmark's point projections take 0.045 s on one, 0.08-0.15 s on two)
         with blas_threads(modes.n_modes):
             observations, t, w = _transient(structure, modes, used, opts, req, step)
         warnings += w

@@ -108,7 +108,7 @@ def test_locate_json_matches_library(capsys):
 
 
 def test_locate_defaults_to_the_models_crew_point(capsys):
-    # issue 9: `microg locate ioc` printed "microg: error: --crew: " (no message)
+    # `microg locate ioc` printed "microg: error: --crew: " (no message)
     rc, out, err = _run(capsys, "locate", "ioc", "--json")
     assert rc == 0 and err == ""
     data = json.loads(out)
@@ -151,7 +151,7 @@ def test_locate_fem_and_damping(capsys):
 
 
 def test_out_is_checked_before_computing(capsys, tmp_path, monkeypatch):
-    # issue 9: an unwritable --out failed only after the computation
+    # an unwritable --out failed only after the computation
     import microg.location.amap as amap
 
     def boom(*args, **kwargs):
@@ -234,7 +234,7 @@ def test_bad_input_is_one_line_exit_2(capsys, tmp_path, args, needle):
     rc, out, err = _run(capsys, *args)
     assert rc == 2 and out == ""
     assert len(err.strip().splitlines()) == 1 and needle in err
-    # issue 9: never a blank message ("microg: error: --crew: " and nothing after it)
+    # never a blank message ("microg: error: --crew: " and nothing after it)
     assert re.match(r"^microg: error: (--[\w-]+( [^:]+)?: )?\S", err), err
 
 
@@ -290,14 +290,14 @@ def test_optimize_readme_example_reports_total_and_parts(capsys):
     assert m, out
     before, after, gain = (float(v) for v in m.groups())
     # the rigid translation f0/M alone (4.1e-5 g for the IOC) bounds what a layout can reach;
-    # the report's gain must be of that order (issue 9 found x5.06e+31)
+    # the report's gain must be of that order
     f0_over_m = 25 * 4.4482216152605 / load_station("ioc").mass_properties()[0] / G0
     assert after > 0.5 * f0_over_m and 1.0 <= gain <= before / (0.5 * f0_over_m)
     assert "rigid-body" in out and "elastic" in out
 
 
 def test_bare_numbers_in_movable_take_the_models_units(capsys, si_model, unitless_model):
-    # issue 9: bare numbers were ft even in an SI model (the dock at -20 m is outside
+    # bare numbers were ft even in an SI model (the dock at -20 m is outside
     # -20 ft .. -4 ft = -6.1 .. -1.2 m, so ft would be an error)
     base = ["optimize", "--maxiter", "2", "--json", "--no-progress"]
     rc, out, err = _run(capsys, *base[:1], str(si_model), *base[1:], "--movable", "dock=-20:-4")

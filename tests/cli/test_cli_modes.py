@@ -130,7 +130,7 @@ def test_bad_model_file_is_one_line(capsys, tmp_path):
 
 
 def test_massless_beam_is_condensed_not_refused(tmp_path, capsys) -> None:
-    # issue 10 section 1: a beam with no mass, clamped to a massive body, is restrained, so its
+    # a beam with no mass, clamped to a massive body, is restrained, so its
     # coordinates are condensed statically; the free-free model still has its 6 rigid modes
     model = tmp_path / "massless.toml"
     model.write_text(
@@ -187,7 +187,7 @@ def test_uff_export_of_an_imported_modal_model(capsys, tmp_path):
     # a NASTRAN OP2 (clamped beam: no rigid mode) written as UFF and read back: the same
     # frequencies to the 6 printed digits (1e-5), and replaced_rigid says none was replaced
     unv = tmp_path / "beam.unv"
-    op2 = str(NASTRAN / "beam_modes_m2.op2")
+    op2 = str(NASTRAN / "beam_modes" / "beam_modes_m2.op2")
     rc, out, err = _run(capsys, op2, "--units", "in,lbf,s", "--uff", str(unv), "--json")
     assert rc == 0 and unv.is_file(), err
     first = json.loads(out)
@@ -200,15 +200,13 @@ def test_uff_export_of_an_imported_modal_model(capsys, tmp_path):
     assert a[0] == pytest.approx(456.66, rel=1e-4)  # the F06's first frequency
 
 
-DECK = Path(__file__).resolve().parents[3] / "shared" / "fixtures" / "nastran" / "beam_modes"
+DECK = NASTRAN / "beam_modes"
 
 
 def test_a_decks_spc_is_said_and_applied_on_request(capsys):
-    # the shared NASTRAN fixture is clamped by SPC = 1: free-free by default, with a warning
+    # the beam_modes NASTRAN fixture is clamped by SPC = 1: free-free by default, with a warning
     # that the SPC is not applied; --constrained applies it and gives NASTRAN's first
     # frequency (F06: 456.6603 Hz; tests/models/test_bdf.py holds every mode to 0.5 %)
-    if not (DECK / "beam_modes.dat").is_file():
-        pytest.skip("shared fixture not present")
     deck = str(DECK / "beam_modes.dat")
     rc, out, err = _run(capsys, deck, "--units", "in,lbf,s", "--json")
     assert rc == 0, err

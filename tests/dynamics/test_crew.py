@@ -193,7 +193,7 @@ def test_amax_general_times(omega: float, t1: float, gap: float, dur: float) -> 
     assert sampled >= exact * (1 - 2e-6)
 
 
-# ------------------------------------------------------- issue 8: one crew-force type, one rule
+# ------------------------------------------------------- one crew-force type, one rule
 
 
 @pytest.mark.parametrize(

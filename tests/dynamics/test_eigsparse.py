@@ -97,7 +97,7 @@ def test_bad_input():
 def test_massless_coordinates_are_condensed_not_refused(dense_max):
     # every other mass of a free-free chain is zero: the massless coordinates are condensed
     # statically. Reference: the chain of the massive ones with two springs in series
-    # (k/2 each), whose closed form is chain_exact with k -> k/2 (issue 10 section 1c)
+    # (k/2 each), whose closed form is chain_exact with k -> k/2
     n = 2 * 1200 + 1 if dense_max == 0 else 2 * 150 + 1
     M, K = chain(n)
     M = sp.diags(np.where(np.arange(n) % 2 == 0, 2.0, 0.0), format="csr")

@@ -1,7 +1,8 @@
 """Tests of microg.dynamics.forces: Eq. 2.16, piecewise-linear histories, CSV files, specs, library.
 
 References: the report's Eq. 2.16 written out independently below; np.interp for linear
-interpolation; the magnitudes of /work/shared/reference/domain.md (Klute, KC-135).
+interpolation; the magnitudes Klute measured on the KC-135 ("Pilot Investigation: Nominal Crew Induced
+Forces in Zero-G", SAE).
 """
 
 from __future__ import annotations
@@ -157,9 +158,9 @@ def test_parse_force_spec(tmp_path):
         parse_force_spec(str(tmp_path / "missing.csv"))
 
 
-def test_library_magnitudes_from_domain_notes():
+def test_library_magnitudes_are_klutes():
     lib = activity_library()
-    # Klute KC-135 values as listed in domain.md
+    # Klute's KC-135 values: foot push-off max 534 N, mean 311 N; hand 267 N, 151 N
     expected = {
         "foot-pushoff-max": 534.0,
         "foot-pushoff-mean": 311.0,
@@ -176,7 +177,7 @@ def test_library_magnitudes_from_domain_notes():
     assert set(expected) <= set(known_force_specs())
 
 
-# ------------------------------------------------------------- issue 10 and 9: the CSV reader
+# ------------------------------------------------------------------------------ the CSV reader
 
 
 @pytest.mark.parametrize(
@@ -260,7 +261,7 @@ def test_csv_a_million_rows_vectorised_and_bad_row_found(tmp_path):
 
 
 def test_csv_unit_suffix_after_underscore(tmp_path):
-    # issue 9 sec. 3: time_s,force_N (and time_ms,force_lbf)
+    # time_s,force_N (and time_ms,force_lbf)
     p = write(tmp_path, "time_s,force_N\n0,0\n1,5\n")
     assert np.array_equal(from_csv(p).force, [0.0, 5.0])
     p = write(tmp_path, "time_ms,force_lbf\n0,0\n500,2\n")
@@ -269,7 +270,7 @@ def test_csv_unit_suffix_after_underscore(tmp_path):
 
 
 def test_csv_three_force_components_give_a_varying_direction(tmp_path):
-    # issue 9 sec. 3: t [s],Fx [N],Fy [N],Fz [N]
+    # t [s],Fx [N],Fy [N],Fz [N]
     p = write(tmp_path, "t [s],Fx [N],Fy [N],Fz [N]\n0,0,0,0\n1,3,4,0\n2,0,0,5\n3,0,0,0\n")
     h = from_csv(p)
     assert h.is_vector and h.direction is None
@@ -361,7 +362,7 @@ _EXPECTED = json.loads((_INPUTS / "expected.json").read_text())
 
 @pytest.mark.parametrize("name", sorted(n for n in _EXPECTED if n.endswith(".csv")))
 def test_reproduction_force_files(name):
-    # small files written from the descriptions of issues 9 and 10 (the message each must give)
+    # small files reproducing defects once found (the message each must give)
     path = _INPUTS / name
     if not _EXPECTED[name]:
         h = parse_force_spec(str(path))

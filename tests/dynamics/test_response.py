@@ -204,7 +204,7 @@ def test_table_and_direct_paths_agree(monkeypatch, n_breaks):
 
 
 def test_piecewise_uniform_grid_keeps_the_table_path():
-    """Issue 10 section 6: each uniform piece of a non-uniform output grid takes the table path."""
+    """Each uniform piece of a non-uniform output grid takes the table path."""
     f = crew_pushoff(t13=13.000000001, t14=14.000000001)
     # two uniform pieces (dt 0.01 then 0.05), the off-grid jump time inserted, one stray time
     t = np.unique(np.r_[np.linspace(0, 20, 2001), np.linspace(20, 100, 1601), 13.000000001, 57.3])
@@ -436,8 +436,8 @@ def _small_model(seed: int = 1, m: int = 10, n: int = 24):
     return omega, zeta, phi, maps, b
 
 
-def test_issue9_peak_with_off_grid_jump_equals_on_grid_peak():
-    """Issue 9 section 1: a jump at 13.000000001 s, off the 0.01 s grid, must give the same peak
+def test_peak_with_off_grid_jump_equals_on_grid_peak():
+    """A jump at 13.000000001 s, off the 0.01 s grid, must give the same peak
     as the jump on the grid (sampling alone loses about 1 % here)."""
     omega, zeta, phi, maps, b = _small_model()
     t = np.arange(0.0, 200.0 + 0.005, 0.01)
@@ -459,8 +459,8 @@ def test_issue9_peak_with_off_grid_jump_equals_on_grid_peak():
     assert sampled_loss > 5e-3
 
 
-def test_issue9_on_the_shipped_ioc_model():
-    """Issue 9 as stated, on the shipped IOC model (3-D assumed modes, 2 per beam, zeta 0.01):
+def test_off_grid_jump_on_the_shipped_ioc_model():
+    """The off-grid jump on the shipped IOC model (3-D assumed modes, 2 per beam, zeta 0.01):
     the lab's sampled peak drops by about 0.9 % when the landing moves 1e-9 s off the grid;
     the exact peak does not move."""
     from microg.dynamics.modes import solve_modes
@@ -594,7 +594,7 @@ def test_peak_response_validation():
 
 
 def test_piecewise_uniform_runs_equal_direct_evaluation_at_every_time(monkeypatch):
-    """Issue 10 section 6: per-piece table path == the closed form evaluated at each time.
+    """Per-piece table path == the closed form evaluated at each time.
 
     Three uniform pieces (dt 0.01 s, 0.05 s, 0.002 s); force breakpoints on a piece boundary
     (20 s), on the grid inside a piece (7.3 s, a jump), off the grid inside a piece (57.31 s, a

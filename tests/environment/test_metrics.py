@@ -176,7 +176,7 @@ def test_five_bins_keep_a_centred_tone_in_its_band():
 
 
 def test_constant_5ug_on_20s_gives_no_band_rms_and_complies():
-    # issue 9: a constant 5 micro-g (quasi-steady, no vibration) gave 1.5-2.1 micro-g in the
+    # a constant 5 micro-g (quasi-steady, no vibration) gave 1.5-2.1 micro-g in the
     # 0.0098-0.025 Hz bands and complies = false on a 20-s record
     t = np.arange(2000) * 0.01
     a = np.zeros((3, t.size))
@@ -227,7 +227,7 @@ def test_unresolved_exceedance_is_not_a_pass():
 
 
 def test_pims_steps_are_the_ssp_curve_near_the_upper_edge():
-    # domain.md: PIMS's steps derive from the SSP 41000 curve evaluated near each band's upper
+    # PIMS's steps derive from the SSP 41000 curve evaluated near each band's upper
     # edge.  For the sloped part (bands 12-40) 18 f_c against 16 f_upper: within 1.5 % (the
     # base-10 ratio 10^0.05 = 1.122, and nominal centres rounded by up to 1 %: 0.16 for
     # 10^-0.8 = 0.1585); the flat parts are exactly 1.125 x the curve at the centre.

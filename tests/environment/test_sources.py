@@ -292,7 +292,7 @@ def test_source_in_python_and_its_load():
 
 
 def test_reading_a_catalogue_does_not_load_pint():
-    """Units come from microg.units' built-in table (issue 8): no pint registry at startup."""
+    """Units come from microg.units' built-in table: no pint registry at startup."""
     import subprocess
     import sys
 

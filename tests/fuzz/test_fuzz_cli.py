@@ -1,4 +1,4 @@
-"""Fuzzer of command-line option strings (issue 10 sec. 7): quantities, directions, force
+"""Fuzzer of command-line option strings: quantities, directions, force
 specs, point names, output paths, with the issue's reproductions as named tests.
 
 Each generator builds an option string from parts whose meaning it knows (a number text, a
@@ -55,7 +55,7 @@ UNITS: dict[str, dict[str, float]] = {
 }
 DEFAULT = {"length": "ft", "time": "s", "force": "lbf", "mass": "kg", "frequency": "Hz"}
 DEFAULT["angular_frequency"] = "rad/s"
-#: texts that are not numbers, with the reproductions of issue 10 sec. 2
+#: texts that are not numbers, with reproductions of strings that once broke the parser
 BAD_NUMBERS = ["9**9**9", "2**1000", "(296", "2,96", "1,5", "nan", "inf", "-inf", "", "+-1",
                "1e400", "0x10", "__import__('os')", "1.2.3", "1_0", "\u0663", "."]  # fmt: skip
 #: unit texts that are not a unit of any dimension here
@@ -437,7 +437,7 @@ def test_isolate_figure8_message_is_not_blank(tmp_path: Path) -> None:
 
 
 def test_package_mass_accepts_a_mass_or_a_weight() -> None:
-    # issue 9 sec. 3: --package-weight "200 kg" failed with "'200 kg' is not a force"
+    # --package-weight "200 kg" failed with "'200 kg' is not a force"
     t = MassOrWeightType("lbf")
     assert t.convert("200 kg", None, None) == 200.0
     assert t.convert("441 lbf", None, None) == pytest.approx(441 * LBF / G0, rel=1e-12)
@@ -450,7 +450,7 @@ def test_package_mass_accepts_a_mass_or_a_weight() -> None:
 
 @pytest.mark.slow  # a full analysis with its report (about 8 s; run in CI too)
 def test_example_station_runs_as_in_the_readme(tmp_path: Path) -> None:
-    # issue 9 sec. 3: microg analyze examples/station.toml --force examples/pushes.csv
+    # microg analyze examples/station.toml --force examples/pushes.csv
     #                 --at hatch --observe rack3
     argv = ["analyze", str(EXAMPLE), "--force", str(ROOT / "examples" / "pushes.csv")]
     argv += ["--at", "hatch", "--observe", "rack3", "--out", "run", "--json", "--no-progress"]

@@ -1,4 +1,4 @@
-"""Fuzzer of CSV force files (issue 10 sec. 7 and sec. 4).
+"""Fuzzer of CSV force files.
 
 Two strategies:
 

@@ -1,8 +1,8 @@
-"""Fuzzer of model files (issue 10 sec. 7): mutated shipped and test models.
+"""Fuzzer of model files: mutated shipped and test models.
 
 Strategy: start from the shipped models (``ioc``, ``ioc-no-orbiter``), the test models
 (``small_si``, ``small_us``) and ``examples/station.toml``; mutate values (numbers, units,
-grammar breakers of issue 10 sec. 2), keys (deleted, misspelt, unknown), nesting (scalars in
+grammar breakers), keys (deleted, misspelt, unknown), nesting (scalars in
 arrays, tables as scalars, deep arrays, duplicated tables) or the text itself (characters,
 lines, BOM); or rewrite quantities in equivalent units.
 
@@ -84,7 +84,7 @@ EQUIVALENT: list[dict[str, float]] = [
 _UNIT_GROUP = {u: g for g in EQUIVALENT for u in g}
 _QUANTITY = re.compile(r"^\s*([-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?)\s*(\S+)\s*$")
 
-#: values that broke or fooled the old reader (issue 10 sec. 2-4) and other trouble
+#: values that broke or fooled the old reader and other trouble
 NASTY: list[Any] = [
     "9**9**9 ft",
     "2**1000 ft",

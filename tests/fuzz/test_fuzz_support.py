@@ -1,4 +1,4 @@
-"""Shared machinery of the input fuzzers (issue 10 sec. 7), with tests of its own.
+"""Shared machinery of the input fuzzers, with tests of its own.
 
 * Profiles: the CI profile (default) is derandomized and fast; ``HYPOTHESIS_PROFILE=fuzz-long``
   runs many more, random examples locally.  Every fuzz test uses :func:`fuzz_settings`.

@@ -1,4 +1,4 @@
-"""The FOH package response's fast paths (issue 10 section 6) against independent references.
+"""The FOH package response's fast paths against independent references.
 
 ``package_response`` takes the diagonal (eigen-coordinate) recurrence on any grid when the state
 matrix diagonalises well; otherwise the shared-map O(N) scan on a uniform grid, and on a grid whose

@@ -115,7 +115,7 @@ def test_broadcasting_and_grid_kernel() -> None:
 
 
 def test_tuning_ratio_conversion() -> None:
-    # f^2 = (k2/m2)/(k1/m1) = 1/(k mu) (domain.md notation -> report's Eq. 4.6)
+    # f^2 = (k2/m2)/(k1/m1) = 1/(k mu) (Den Hartog's notation -> report's Eq. 4.6)
     m1, k1, m2, k2 = 2.0, 5.0, 0.1, 0.7
     k, mu = k1 / k2, m2 / m1
     f = np.sqrt((k2 / m2) / (k1 / m1))

@@ -19,7 +19,7 @@ from microg.models.bdf import _value, load_bdf, read_cards
 from microg.structure.frame import assemble_frame, build_frame
 from microg.units import IN, LBF
 
-FIXTURE = Path(__file__).resolve().parents[3] / "shared" / "fixtures" / "nastran" / "beam_modes"
+FIXTURE = Path(__file__).resolve().parents[1] / "data" / "nastran" / "beam_modes"
 
 # reader tests run in the main environment and again in the pyNastran one (.ci/nastran-extra.sh)
 pytestmark = pytest.mark.nastran
@@ -324,8 +324,6 @@ def test_coupmass_selects_consistent_mass(tmp_path):
 
 
 def test_fixture_deck_cards_and_ignored_ones():
-    if not (FIXTURE / "beam_modes.dat").is_file():
-        pytest.skip("shared fixture not present")
     g = load_bdf(FIXTURE / "beam_modes.dat", units="in, lbf, s")
     assert len(g.nodes) == 12 and len(g.beams) == 10 and len(g.masses) == 1
     assert g.meta["ignored_cards"] == {"EIGRL": 1, "USET": 1}
@@ -436,8 +434,7 @@ def test_reader_agrees_with_pynastran(tmp_path):
     pn = pytest.importorskip("pyNastran.bdf.bdf")
     decks = {"cs": DECK_CS, "conm2": DECK_CONM2, "props": DECK_PROPS}
     paths = {k: _deck(tmp_path, v, f"{k}.bdf") for k, v in decks.items()}
-    if (FIXTURE / "beam_modes.dat").is_file():
-        paths["fixture"] = FIXTURE / "beam_modes.dat"
+    paths["fixture"] = FIXTURE / "beam_modes.dat"
     checked = 0
     for key, path in paths.items():
         ours = load_bdf(path, units="m, N, s")

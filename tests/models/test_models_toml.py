@@ -642,7 +642,7 @@ def test_ioc_models_load():
     """The shipped IOC models (written by the lead from the seed report) load through the loader.
 
     Total mass: the report's m11 (Appendix C-1 / C-2) is 608,600 lb / 32.2 with the orbiter and
-    373,200 lb / 32.2 without (reading of ../shared/reference/seed-review.md).  The keel masses
+    373,200 lb / 32.2 without (the report's Table 3 and Appendix C).  The keel masses
     of the file are fitted to Appendix C, so this is not an independent check of the data; it
     checks the loader's conversion chain end to end (lbf and slug/ft under 32.2 ft/s^2, beam
     mass per length times length).  Tolerance: the printed totals have 4 significant figures

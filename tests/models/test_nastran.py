@@ -19,7 +19,7 @@ from microg.structure.modal import modal_structure
 pytestmark = pytest.mark.nastran
 
 DATA = Path(__file__).parent.parent / "data" / "nastran"
-BEAM = DATA / "beam_modes_m2.op2"
+BEAM = DATA / "beam_modes" / "beam_modes_m2.op2"
 
 
 def _write_op2(tables, path):

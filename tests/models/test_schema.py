@@ -1,4 +1,4 @@
-"""Limits of model files (issue 10 sec. 3 and 4): physical magnitudes, counts, nesting, size.
+"""Limits of model files: physical magnitudes, counts, nesting, size.
 
 Each test is named after the reproduction it covers.  Reference values: the WGS 84 equatorial
 radius 6378.137 km, the exact foot 0.3048 m; the limits themselves are the documented ones
@@ -224,7 +224,7 @@ def test_model_directions_use_the_one_parser() -> None:
 
 
 def test_model_modules_split_by_concept() -> None:
-    # issue 8: schema, messages, builder, catalogue and load/dump in their own modules; the
+    # schema, messages, builder, catalogue and load/dump in their own modules; the
     # public entry stays microg.models.toml
     assert toml_module.shipped_models is catalog.shipped_models
     assert toml_module.FileIn is schema.FileIn
@@ -243,7 +243,7 @@ EXPECTED = __import__("json").loads((INPUTS / "expected.json").read_text())
 
 @pytest.mark.parametrize("name", sorted(n for n in EXPECTED if n.endswith(".toml")))
 def test_reproduction_model_files(name: str) -> None:
-    # small files written from the descriptions of issue 10 (the message each must give)
+    # small files reproducing defects once found (the message each must give)
     path = INPUTS / name
     if not EXPECTED[name]:
         assert load_station(path).name == "small-si"  # a valid input (BOM)

@@ -1,4 +1,4 @@
-"""The compiled-template cache of microg.report.html (issue 8, "Speed of the main job").
+"""The compiled-template cache of microg.report.html.
 
 Reference: the same template compiled without a cache (Jinja's own compiler), byte for byte.
 """

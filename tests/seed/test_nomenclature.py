@@ -16,7 +16,7 @@ from microg.report.html import png_data_uri, render_reproduction
 from microg.seed.nomenclature import NOMENCLATURE, nomenclature
 from microg.seed.reproduce import reproduce
 
-#: what the review asked for by name (issue 9 section 4 and the brief)
+#: the symbols a reader of the report looks up by name
 REQUIRED = [
     "a_e", "I_x", "I_y", "z_a", "z_e", "l_k", "l_s", "EI", "m_ij", "k_ij", "w", "[A]max",
     "M_a", "r", "mu", "M_jj", "phi_ij", "w_j", "f0", "t1", "t13", "t14", "R", "Z", "CG",

@@ -1,7 +1,6 @@
 """The seed report's record and the provenance of a reproduction.
 
-References: the OCR'd copy of the report (``../shared/seed/``, beside the clone as CI lays it
-out), the shipped files read directly from the package directory, and hashlib.
+References: the OCR'd copy of the report (``tests/data/seed/``), the shipped files read directly from the package directory, and hashlib.
 """
 
 from __future__ import annotations
@@ -18,12 +17,10 @@ from microg.models.toml import load_station
 from microg.seed.source import SEED_REPORT, reproduction_meta, station_record
 
 ROOT = Path(__file__).resolve().parents[2]
-SEED = ROOT.parent / "shared" / "seed" / SEED_REPORT.file_name
+SEED = ROOT / "tests" / "data" / "seed" / SEED_REPORT.file_name
 DATA = Path(microg.__file__).resolve().parent / "data"
-needs_seed = pytest.mark.skipif(not SEED.is_file(), reason="../shared/seed is not beside the clone")
 
 
-@needs_seed
 def test_title_is_the_reports_first_line() -> None:
     # the OCR'd copy opens with the title in capitals: the record's title, word for word
     first = SEED.read_text(encoding="utf-8").strip().splitlines()[0].strip()
@@ -34,12 +31,10 @@ def test_title_is_the_reports_first_line() -> None:
     )
 
 
-@needs_seed
 def test_recorded_sha256_is_the_files() -> None:
     assert hashlib.sha256(SEED.read_bytes()).hexdigest() == SEED_REPORT.file_sha256
 
 
-@needs_seed
 def test_no_year_later_than_1984_is_cited() -> None:
     # the year note says: not printed, the latest cited work is of August 1984
     text = SEED.read_text(encoding="utf-8")

@@ -1,6 +1,6 @@
 """Validation: microg's frame FE of the ``beam_modes`` deck against Simcenter Nastran's SOL 103.
 
-Fixture: ``../shared/fixtures/nastran/beam_modes/`` (a real Simcenter Nastran 2019.2 run from
+Fixture: ``tests/data/nastran/beam_modes/`` (a real Simcenter Nastran 2019.2 run from
 the pyNastran repository, BSD): ``beam_modes.dat`` INCLUDEs ``cbar_cbeam.blk`` (9 CBAR with a
 PBARL ROD and 1 CBEAM with a PBEAML ROD along x, a CONM2 at the tip, grid 1 clamped by
 SPC 1).  The F06's real eigenvalue table and printed eigenvectors are parsed here.
@@ -31,13 +31,12 @@ from microg.models.bdf import load_bdf
 from microg.structure.frame import build_frame
 from microg.units import IN, LBF
 
-FIXTURE = Path(__file__).resolve().parents[3] / "shared" / "fixtures" / "nastran" / "beam_modes"
+FIXTURE = Path(__file__).resolve().parents[1] / "data" / "nastran" / "beam_modes"
 DECK = FIXTURE / "beam_modes.dat"
 F06 = FIXTURE / "beam_modes.f06"
 
 pytestmark = [
     pytest.mark.nastran,
-    pytest.mark.skipif(not DECK.is_file(), reason="shared NASTRAN fixture not present"),
 ]
 
 

@@ -1,6 +1,6 @@
 """The OP2 reader against NASTRAN's own printed output and against pyyeti's/pyNastran's readers.
 
-Fixtures (tests/data/nastran/): beam_modes_m2.op2 + beam_modes.f06, a Simcenter Nastran SOL 103
+Fixtures (tests/data/nastran/): beam_modes/beam_modes_m2.op2 + beam_modes.f06, a Simcenter Nastran SOL 103
 run (pyNastran models/, BSD, LICENSE-pyNastran.md); cla_residual.op2, a free-free SOL 103
 residual run with a CORD2R output system (pyyeti tests/cla_test_data_2020, LICENSE-pyyeti.txt).
 """
@@ -19,8 +19,8 @@ from microg.models.nastran import modal_model_from_op2, read_op2_modes
 pytestmark = pytest.mark.nastran
 
 DATA = Path(__file__).parent.parent / "data" / "nastran"
-BEAM = DATA / "beam_modes_m2.op2"
-F06 = DATA / "beam_modes.f06"
+BEAM = DATA / "beam_modes" / "beam_modes_m2.op2"
+F06 = DATA / "beam_modes" / "beam_modes.f06"
 CLA = DATA / "cla_residual.op2"
 
 

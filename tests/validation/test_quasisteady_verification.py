@@ -1,4 +1,4 @@
-"""Verification of the quasi-steady terms against independent references (issue 12, section 4).
+"""Verification of the quasi-steady terms against independent references.
 
 * Gravity gradient: the difference of two-body gravity at the point and at the centre of mass,
   computed in 50-digit decimal arithmetic (no cancellation problem there).

@@ -1,4 +1,4 @@
-"""Property: a free structure's modes do not depend on where its model sits (issue 10, 1b).
+"""Property: a free structure's modes do not depend on where its model sits.
 
 Random tree stations (bodies with point masses, beams on bodies and on beams, with and
 without ``ea``, some massless beams carrying point masses) are translated and rotated as a

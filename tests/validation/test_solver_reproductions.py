@@ -1,7 +1,7 @@
-"""The solver reproductions of issues 10 (section 1) and 9 (sections 1 and 3), each by name.
+"""Reproductions of solver defects once found, each by name.
 
 Every model is under tests/data/models/ (``solver_*.toml``) or shipped.  Each test states the
-defect as the issue does and checks the fixed behaviour against an independent reference.
+defect as it was found and checks the fixed behaviour against an independent reference.
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ def _model(name: str) -> Station:
     return load_station(DATA / f"solver_{name}.toml")
 
 
-# ------------------------------------------------------------------ issue 10, section 1
+# ------------------------------------------------------------ solver models and chains
 
 
 def test_fine_mesh_2000_elements_is_not_a_mechanism():
@@ -231,7 +231,7 @@ def test_500_stub_beams_on_one_body():
     assert np.median(stub) == pytest.approx(clamped, rel=1e-5)
 
 
-# ------------------------------------------------------------------ issue 9, sections 1, 3
+# ------------------------------------------------------------ peaks and unit systems
 
 
 def test_libration_same_in_si_and_us_files_at_16_functions():

@@ -75,7 +75,7 @@ def main(argv: list[str] | None = None) -> int:
     Run as the process (``argv`` None: the ``microg`` script, ``python -m microg``), the
     objects alive at the end are frozen out of the garbage collector (``gc.freeze``) before
     the interpreter exits: its final collections over matplotlib's and scipy's object graphs
-    took ~0.25 s of a 2-s ``microg analyze`` (issue 8), for memory the exit frees anyway.
+    took ~0.25 s of a 2-s ``microg analyze``, for memory the exit frees anyway.
     The exit itself (atexit handlers, stream flushes, module teardown) is unchanged.
     """
     if argv is None:

@@ -307,7 +307,7 @@ def _renderer() -> Any:
 
     Only the ``microg`` process starts them, before it loads the model: they import
     matplotlib (and the modules the result unpickles with) on the second core while this
-    process loads and computes, then draw the figures (issue 8).  A library caller of
+    process loads and computes, then draw the figures.  A library caller of
     :func:`main` draws in-process, as ``microg.analyze`` users do.
     """
     from microg.cli._startup import is_process

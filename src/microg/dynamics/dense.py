@@ -13,7 +13,7 @@ Method (:func:`solve_dense`), each step a documented choice:
    stiffness, or a stiffness contrast, is not swamped by the rounding of a rotation.
 3. **Graded inverse iteration, bottom up** (:func:`graded_eigh`).  ``eigh(K, M)`` has an
    absolute eigenvalue error ``eps lambda_max``: it loses a libration mode 1e-18 of the
-   largest eigenvalue (issue 9: 1-5 % on a 16-function Ritz model whose mass matrix has
+   largest eigenvalue (1-5 % on a 16-function Ritz model whose mass matrix has
    condition 1e16).  The inverse form ``M_s y = mu (K_s + s M_s) y`` has error
    ``eps mu_max`` in ``mu = 1 / (lambda + s)``, i.e. a relative error
    ``eps (lambda + s)^2 / ((lambda_min + s) lambda)``: exact for the lowest modes.  Modes

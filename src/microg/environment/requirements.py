@@ -203,8 +203,8 @@ def ssp41000_requirement() -> Requirement:
         bands=bands,
         limit_g=ssp41000_limit_g(bands.center_hz),
         source="SSP 41000 vibratory curve (1.6 ug to 0.1 Hz, 16 f ug to 100 Hz, 1600 ug "
-        "above), evaluated at the band centres of PIMS's table; "
-        "/work/shared/reference/domain.md",
+        "above), evaluated at the band centres of PIMS's 1/3-octave table "
+        "(get_oto_iss_req_steps, otorunhist/main.py, github.com/baluneboy/pims)",
     )
 
 

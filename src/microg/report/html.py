@@ -3,8 +3,8 @@
 The report reads result objects only; it computes nothing.  Compiled templates are kept in
 Jinja's bytecode cache (a directory of the user's own under the system's temporary directory,
 as :class:`jinja2.FileSystemBytecodeCache` makes it), checked against the template's source:
-compiling ``analyze.html`` takes ~0.1 s, loading it from the cache ~1 ms (issue 8, "Speed of
-the main job").  Without a usable cache directory the templates are compiled as before.
+compiling ``analyze.html`` takes ~0.1 s, loading it from the cache ~1 ms.
+Without a usable cache directory the templates are compiled as before.
 """
 
 from __future__ import annotations

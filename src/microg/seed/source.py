@@ -3,8 +3,8 @@
 The report: its title, what the OCR'd copy shows of its origin.  The provenance: version, time,
 command, the files the numbers come from, with sha256.
 
-The report is not shipped: its OCR'd copy lives beside the project (``../shared/seed/``).
-The values microg compares against were read from that copy into
+The report is not shipped with microg.  The values microg compares against were read from its
+OCR'd copy into
 ``microg/data/_seed_printed.toml``, which is shipped and hashed at run time, as are the model
 files the reproduction reads.
 """
@@ -47,7 +47,7 @@ class SeedReport:
     program : str
         The programme it was written under.
     file_name, file_sha256 : str
-        The OCR'd copy the printed values were read from (``../shared/seed/``, not shipped).
+        The OCR'd copy the printed values were read from (not shipped).
     """
 
     title: str
