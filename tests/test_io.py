@@ -9,6 +9,7 @@ after sanitising get distinct files.
 from __future__ import annotations
 
 import errno
+import hashlib
 import json
 import os
 import random
@@ -62,7 +63,11 @@ def test_run_directory_is_replaced_whole_and_stale_figures_go(tmp_path: Path) ->
     assert (out / "report.html").read_text() == "new"
     assert _listing(tmp_path) == ["run"]  # no temporary sibling left
     marker = json.loads((out / RUN_MARKER).read_text())
-    assert marker["files"] == ["report.html", "results.json"]
+    # the manifest: every file the run wrote with the SHA-256 of its bytes (hashlib directly)
+    assert marker["files"] == {
+        "report.html": hashlib.sha256(b"new").hexdigest(),
+        "results.json": hashlib.sha256(b"{}").hexdigest(),
+    }
     umask = os.umask(0)
     os.umask(umask)
     assert stat.S_IMODE(out.stat().st_mode) == 0o777 & ~umask  # not mkdtemp's 0700
@@ -76,11 +81,11 @@ def test_write_output_files_is_the_run_writer(tmp_path: Path) -> None:
 
 def test_refuses_a_non_empty_directory_microg_did_not_write(tmp_path: Path) -> None:
     (tmp_path / "notes.txt").write_text("mine")
-    with pytest.raises(InputError, match=f"no {RUN_MARKER} marker") as exc:
+    with pytest.raises(InputError, match=f"no {RUN_MARKER} manifest") as exc:
         write_run_directory(tmp_path, {"r.json": "{}"}, where="--out")
     assert exc.value.where == "--out"
     assert _listing(tmp_path) == ["notes.txt"] and (tmp_path / "notes.txt").read_text() == "mine"
-    with pytest.raises(InputError, match="marker"):
+    with pytest.raises(InputError, match="manifest"):
         check_writable(tmp_path, "--out")  # the same answer before any computation
 
 
@@ -243,19 +248,168 @@ def test_killed_at_random_points_leaves_one_complete_run(tmp_path: Path) -> None
     assert _listing(out) == [RUN_MARKER, "report.html"]
 
 
-def test_stale_temporaries_of_live_processes_are_kept(tmp_path: Path) -> None:
+def _locked(path: Path) -> int:
+    """An open, locked lock file at ``path`` (a run that is still writing): its descriptor."""
+    import fcntl
+
+    fd = os.open(path, os.O_CREAT | os.O_RDWR, 0o600)
+    fcntl.flock(fd, fcntl.LOCK_EX)
+    return fd
+
+
+@pytest.mark.skipif(os.name == "nt", reason="the test holds its lock with fcntl")
+def test_stale_temporaries_are_removed_only_when_their_run_is_over(tmp_path: Path) -> None:
     out = tmp_path / "run"
-    mine = tmp_path / f".run.microg-tmp-{os.getpid()}-abc"  # a concurrent run (alive)
-    mine.mkdir()
-    (mine / RUN_MARKER).write_text("{}")
-    dead = tmp_path / ".run.microg-tmp-999999999-abc"  # no such process
+    live = tmp_path / ".run.microg-tmp-1-aaaa"  # a concurrent run: its lock is held
+    live.mkdir()
+    (live / "fig.png").write_bytes(b"x")
+    fd = _locked(tmp_path / ".run.microg-tmp-1-aaaa.lock")
+    dead = tmp_path / ".run.microg-tmp-2-bbbb"  # killed before its marker: lock file, free
     dead.mkdir()
-    (dead / RUN_MARKER).write_text("{}")
-    notours = tmp_path / ".run.microg-tmp-999999999-xyz"
+    (dead / "fig.png").write_bytes(b"x")
+    (tmp_path / ".run.microg-tmp-2-bbbb.lock").write_bytes(b"")
+    notours = tmp_path / ".run.microg-tmp-3-cccc"  # named like one, but no lock file
     notours.mkdir()
-    (notours / "data.txt").write_text("not a run")  # no marker: left alone
-    write_run_directory(out, {"a": "1"}, where="out")
-    assert mine.exists() and not dead.exists() and notours.exists()
+    (notours / "data.txt").write_text("not a run")
+    try:
+        write_run_directory(out, {"a": "1"}, where="out")
+    finally:
+        os.close(fd)
+    assert live.exists() and (live / "fig.png").exists()
+    assert not dead.exists() and not (tmp_path / ".run.microg-tmp-2-bbbb.lock").exists()
+    assert (notours / "data.txt").read_text() == "not a run"  # never deleted
+
+
+def test_stale_detection_never_signals_a_process(tmp_path: Path, monkeypatch) -> None:
+    # os.kill(pid, 0) terminates the process on Windows: no process is ever signalled
+    def no_kill(*args):
+        raise AssertionError("os.kill called")
+
+    monkeypatch.setattr(os, "kill", no_kill)
+    dead = tmp_path / f".run.microg-tmp-{os.getpid()}-dddd"
+    dead.mkdir()
+    (tmp_path / f".run.microg-tmp-{os.getpid()}-dddd.lock").write_bytes(b"")
+    write_run_directory(tmp_path / "run", {"a": "1"}, where="out")
+    assert _listing(tmp_path) == ["run"]
+
+
+# -------------------------------------------- a run deletes only what an earlier run wrote
+
+
+def test_an_empty_marker_does_not_make_a_directory_microgs(tmp_path: Path) -> None:
+    # an empty .microg-run beside a user's files used to let a run wipe them (exit 0)
+    out = tmp_path / "mine"
+    out.mkdir()
+    (out / RUN_MARKER).write_text("")
+    (out / "notes.txt").write_text("keep me")
+    (out / "data").mkdir()
+    (out / "data" / "x.csv").write_text("1,2")
+    with pytest.raises(InputError, match="microg did not write"):
+        check_writable(out, "--out")
+    with pytest.raises(InputError, match="microg did not write"):
+        write_run_directory(out, {"r.json": "{}"}, where="--out")
+    assert (out / "notes.txt").read_text() == "keep me"
+    assert (out / "data" / "x.csv").read_text() == "1,2"
+
+
+@pytest.mark.parametrize("marker", ['{"microg_run": 1, "files": ["r.json"]}', "{}", "[1]", "x"])
+def test_a_marker_without_microgs_manifest_is_refused(tmp_path: Path, marker: str) -> None:
+    # a manifest of names without hashes (microg 0.2) cannot show that nothing was changed
+    out = tmp_path / "old"
+    out.mkdir()
+    (out / RUN_MARKER).write_text(marker)
+    (out / "r.json").write_text("{}")
+    with pytest.raises(InputError, match="manifest"):
+        write_run_directory(out, {"r.json": "{}"}, where="--out")
+    assert (out / "r.json").read_text() == "{}"
+
+
+def test_a_file_added_to_an_earlier_run_is_kept_and_named(tmp_path: Path) -> None:
+    out = tmp_path / "run"
+    write_run_directory(out, {"report.html": "old", "figs/a.png": b"a"}, where="out")
+    (out / "my-notes.txt").write_text("mine")
+    (out / "figs" / "annotated.png").write_bytes(b"mine")
+    with pytest.raises(InputError, match="did not write") as exc:
+        write_run_directory(out, {"report.html": "new"}, where="--out")
+    msg = str(exc.value)
+    assert "my-notes.txt" in msg and "figs/annotated.png" in msg and "\n" not in msg
+    assert exc.value.where == "--out"
+    assert (out / "my-notes.txt").read_text() == "mine"
+    assert (out / "report.html").read_text() == "old"  # the earlier run is untouched
+
+
+def test_a_file_edited_in_an_earlier_run_is_kept_and_named(tmp_path: Path) -> None:
+    out = tmp_path / "run"
+    write_run_directory(out, {"report.html": "old", "results.json": "{}"}, where="out")
+    (out / "report.html").write_text("old, with my remarks")
+    with pytest.raises(InputError, match="report.html"):
+        check_writable(out, "--out")
+    assert (out / "report.html").read_text() == "old, with my remarks"
+
+
+@pytest.mark.parametrize("extra", ["link", "emptydir"])
+def test_links_and_empty_directories_are_not_microgs(tmp_path: Path, extra: str) -> None:
+    out = tmp_path / "run"
+    write_run_directory(out, {"a.txt": "1"}, where="out")
+    if extra == "link":
+        (tmp_path / "elsewhere.txt").write_text("precious")
+        (out / "ln").symlink_to(tmp_path / "elsewhere.txt")
+    else:
+        (out / "empty").mkdir()
+    with pytest.raises(InputError, match="did not write"):
+        write_run_directory(out, {"a.txt": "2"}, where="out")
+    if extra == "link":
+        assert (tmp_path / "elsewhere.txt").read_text() == "precious"
+
+
+def test_a_file_added_after_the_check_survives_the_replacement(tmp_path: Path, monkeypatch):
+    # the race between the last check and the removal of the previous run: whatever appeared
+    # in it is kept, in a visible sibling (NAME.microg-kept-TOKEN), never deleted
+    out = tmp_path / "run"
+    write_run_directory(out, {"report.html": "old"}, where="out")
+    real_swap = io_mod._swap
+
+    def swap_then_user_writes(new, target, stem):
+        previous = real_swap(new, target, stem)
+        (previous / "late.txt").write_text("written during the swap")
+        return previous
+
+    monkeypatch.setattr(io_mod, "_swap", swap_then_user_writes)
+    write_run_directory(out, {"report.html": "new"}, where="out")
+    assert (out / "report.html").read_text() == "new"
+    kept = [p for p in tmp_path.iterdir() if p.name.startswith("run.microg-kept-")]
+    assert len(kept) == 1 and (kept[0] / "late.txt").read_text() == "written during the swap"
+    assert not (kept[0] / "report.html").exists()  # the old run's own file is gone
+
+
+def test_a_link_to_an_existing_directory_is_followed(tmp_path: Path) -> None:
+    real = tmp_path / "real"
+    real.mkdir()
+    link = tmp_path / "out"
+    link.symlink_to(real)
+    write_run_directory(link, {"a.txt": "1"}, where="--out")
+    write_run_directory(link, {"a.txt": "2"}, where="--out")  # and replaced there again
+    assert link.is_symlink() and (real / "a.txt").read_text() == "2"
+
+
+@pytest.mark.parametrize("kind", ["dangling", "to-file"])
+def test_a_link_to_anything_else_is_refused(tmp_path: Path, kind: str) -> None:
+    dest = tmp_path / "no" / "such" / "dir" if kind == "dangling" else tmp_path / "f.txt"
+    if kind == "to-file":
+        dest.write_text("file")
+    link = tmp_path / "out"
+    link.symlink_to(dest)
+    for call in (
+        lambda: check_writable(link, "--out"),
+        lambda: write_run_directory(link, {"a.txt": "1"}, where="--out"),
+    ):
+        with pytest.raises(InputError, match="symbolic link") as exc:
+            call()
+        assert exc.value.where == "--out"
+    assert not (tmp_path / "no").exists()  # the link's target's parents are not created
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
+        ["out"] + (["f.txt"] if kind == "to-file" else [])
+    )
 
 
 def test_safe_filenames_a_slash_b_and_a_underscore_b() -> None:

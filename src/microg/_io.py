@@ -5,15 +5,18 @@ A command's output (report, figures, JSON) is a **run directory**, written all a
 
 * the whole run is written into a hidden temporary sibling directory, then swapped in with one
   rename (Linux ``renameat2(RENAME_EXCHANGE)``; elsewhere two renames), so the target always
-  holds one complete run, the previous one until the swap and the new one after it; the
-  previous run is then removed;
-* a run directory carries a small marker file :data:`RUN_MARKER`; a non-empty directory
-  without it is never replaced or deleted (it is not microg's);
+  holds one complete run, the previous one until the swap and the new one after it;
+* a run directory carries a marker file :data:`RUN_MARKER`, the manifest of the files the run
+  wrote with their SHA-256.  A directory is replaced only when it is empty or holds exactly
+  the files of its manifest, unchanged; anything else (a file added or edited, a marker that
+  is not microg's manifest) is refused, naming what is there;
+* the previous run is then deleted file by file from its manifest (a file changed since is
+  kept), so a run never deletes a file it did not write;
 * on any error (disk full, permissions) or on SIGINT/SIGTERM, the temporary directory is
   removed and the previous run is left as it was.  A SIGKILL can leave only a hidden
-  temporary sibling (``.NAME.microg-tmp-PID-*``), which the next run into the same place
-  removes;
-* files of an earlier run that the new run does not write (stale figures) disappear with it.
+  temporary sibling (``.NAME.microg-tmp-PID-TOKEN``) and its lock file, which the next run
+  into the same place removes once the lock shows that their run is over;
+* a symbolic link as the output is followed only to an existing directory.
 
 :func:`check_writable` checks an output path before any computation, and
 :func:`safe_filenames` gives unique, stable file names for arbitrary point names.
@@ -199,8 +202,73 @@ def safe_filenames(names: Iterable[str]) -> dict[str, str]:
 # --------------------------------------------------------------------------- run directories
 
 
-def _has_marker(path: Path) -> bool:
-    return (path / RUN_MARKER).is_file()
+#: version of the marker's manifest (file name -> SHA-256 of its bytes)
+_MANIFEST_VERSION = 2
+
+
+def _sha256(path: Path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for chunk in iter(lambda: fh.read(1 << 20), b""):
+            h.update(chunk)
+    return h.hexdigest()
+
+
+def _manifest(path: Path) -> dict[str, str] | None:
+    """The files a microg run wrote in ``path`` (name -> SHA-256), or None if not a run."""
+    try:
+        data = json.loads((path / RUN_MARKER).read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, ValueError):
+        return None
+    if not isinstance(data, dict) or data.get("microg_run") != _MANIFEST_VERSION:
+        return None
+    files = data.get("files")
+    if not isinstance(files, dict):
+        return None
+    if not all(isinstance(k, str) and isinstance(v, str) for k, v in files.items()):
+        return None
+    return files
+
+
+def _entries(path: Path) -> tuple[set[str], set[str]]:
+    """(files, other entries) below ``path``, relative POSIX names; links are never followed.
+
+    A directory counts as an entry of its own only when it is empty; symbolic links and
+    special files are "other" entries.
+    """
+    files: set[str] = set()
+    other: set[str] = set()
+    for root, dirs, names in os.walk(path, followlinks=False):
+        rel = Path(root).relative_to(path)
+        for name in dirs:
+            full = Path(root) / name
+            if full.is_symlink():
+                other.add((rel / name).as_posix())
+            elif _is_empty_dir(full):
+                other.add((rel / name).as_posix() + "/")
+        for name in names:
+            full = Path(root) / name
+            key = (rel / name).as_posix()
+            if full.is_symlink() or not full.is_file():
+                other.add(key)
+            elif key != RUN_MARKER:
+                files.add(key)
+    return files, other
+
+
+def _foreign(path: Path) -> list[str] | None:
+    """What in ``path`` microg did not write there (sorted), or None if it is not a run.
+
+    A run directory holds exactly the files its marker lists, each with the SHA-256 the
+    marker records; anything else (a file added, a file changed, a link, an empty directory)
+    is foreign.
+    """
+    manifest = _manifest(path)
+    if manifest is None:
+        return None
+    files, other = _entries(path)
+    changed = sorted(n for n in files & set(manifest) if _sha256(path / n) != manifest[n])
+    return sorted(files - set(manifest)) + changed + sorted(other)
 
 
 def _is_empty_dir(path: Path) -> bool:
@@ -209,18 +277,26 @@ def _is_empty_dir(path: Path) -> bool:
 
 
 def _resolve_target(path: str | Path | None, where: str) -> Path:
-    """The absolute output directory, checked: not empty text, not cwd, not a file."""
+    """The absolute output directory, checked: not empty text, not cwd, not a dangling link."""
     if path is None or not str(path).strip():
         raise InputError(
             "is empty", where=where, fix="name an output directory, e.g. 'microg-results'"
         )
     text = str(path)
     if "\x00" in text:
-        raise InputError("holds a NUL character", where=where)
+        raise InputError("holds a NUL character", where=where, fix="name a plain directory")
     target = Path(os.path.abspath(text))
     try:
         if target.is_symlink():
-            target = target.resolve()
+            dest = target.resolve()
+            if not dest.is_dir():
+                raise InputError(
+                    f"{text!r} is a symbolic link to {str(dest)!r}, which is not an existing "
+                    "directory; microg follows a link only to an existing directory",
+                    where=where,
+                    fix="create the directory it points to, or name another output directory",
+                )
+            target = dest
         cwd = Path.cwd().resolve()
     except OSError as exc:
         raise InputError(f"cannot use {text!r}: {exc.strerror or exc}", where=where) from None
@@ -234,19 +310,50 @@ def _resolve_target(path: str | Path | None, where: str) -> Path:
     return target
 
 
-def _check_replaceable(target: Path, text: str, where: str) -> None:
+def _listed(names: list[str], limit: int = 3) -> str:
+    shown = ", ".join(repr(n) for n in names[:limit])
+    return shown + (f" and {len(names) - limit} more" if len(names) > limit else "")
+
+
+def _check_replaceable(target: Path, text: str, where: str, *, resumable: bool = False) -> None:
+    """Refuse a target that holds anything an earlier microg run did not write there."""
     try:
         if target.exists() and not target.is_dir():
-            raise InputError(f"{text!r} exists and is not a directory", where=where)
-        if target.is_dir() and not _has_marker(target) and not _is_empty_dir(target):
+            raise InputError(
+                f"{text!r} exists and is not a directory", where=where, fix="name a directory"
+            )
+        if not target.is_dir() or _is_empty_dir(target):
+            return
+        if resumable and _is_sweep(target):
+            return
+        foreign = _foreign(target)
+        if foreign is None:
             raise InputError(
                 f"{text!r} is a non-empty directory that microg did not write (it has no "
-                f"{RUN_MARKER} marker); microg replaces its output directory as a whole",
+                f"{RUN_MARKER} manifest of microg's files); microg replaces its output "
+                "directory as a whole",
                 where=where,
                 fix="choose a new or empty directory, or one that microg wrote",
             )
+        if foreign:
+            raise InputError(
+                f"{text!r} holds what the earlier microg run there did not write: "
+                f"{_listed(foreign)}; microg replaces a run directory only when it holds "
+                "exactly that run's files",
+                where=where,
+                fix="move those out, or choose another directory",
+            )
     except OSError as exc:
         raise InputError(f"cannot use {text!r}: {exc.strerror or exc}", where=where) from None
+
+
+def _is_sweep(path: Path) -> bool:
+    """A sweep's output directory (resumed in place, never replaced whole)."""
+    try:
+        data = json.loads((path / RUN_MARKER).read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, ValueError):
+        return False
+    return isinstance(data, dict) and data.get("command") == "sweep"
 
 
 def _existing_ancestor(path: Path) -> Path:
@@ -256,7 +363,9 @@ def _existing_ancestor(path: Path) -> Path:
     return Path(path.anchor)
 
 
-def check_writable(path: str | Path | None, where: str, *, directory: bool = True) -> Path:
+def check_writable(
+    path: str | Path | None, where: str, *, directory: bool = True, resumable: bool = False
+) -> Path:
     """Check, before computing anything, that output can be written to ``path``.
 
     Parameters
@@ -264,29 +373,36 @@ def check_writable(path: str | Path | None, where: str, *, directory: bool = Tru
     path : the output directory (``directory=True``) or file
     where : parameter named in the error
     directory : True for a run directory (:func:`write_run_directory`), False for one file
+    resumable : a sweep's directory, resumed in place: one that a sweep marked is accepted too
 
     Returns
     -------
     Path
-        The absolute path that will be written.
+        The absolute path that will be written (a symbolic link to an existing directory
+        resolved).
 
     Raises
     ------
     InputError
-        The path is empty, is the current directory, is a file where a directory is needed
-        (or the reverse), is a non-empty directory microg did not write, or its parent
-        cannot be written (probed by creating and removing a temporary entry).
+        The path is empty, is the current directory, is a symbolic link to anything but an
+        existing directory, is a file where a directory is needed (or the reverse), holds
+        anything that an earlier microg run did not write there, or its parent cannot be
+        written (probed by creating and removing a temporary entry).
     """
     text = "" if path is None else str(path)
     if directory:
         target = _resolve_target(path, where)
-        _check_replaceable(target, text, where)
+        _check_replaceable(target, text, where, resumable=resumable)
     else:
         if not text.strip() or "\x00" in text:
-            raise InputError("is empty", where=where, fix="name an output file")
+            raise InputError("is empty or holds a NUL", where=where, fix="name an output file")
         target = Path(os.path.abspath(text))
         if target.is_dir():
             raise InputError(f"{text!r} is a directory", where=where, fix="name a file")
+        if target.is_symlink() and not target.exists():
+            raise InputError(
+                f"{text!r} is a symbolic link to nothing", where=where, fix="name a plain file"
+            )
     probe_in = _existing_ancestor(target.parent)
     try:
         if not probe_in.is_dir():
@@ -336,38 +452,96 @@ def _exchange(a: Path, b: Path) -> bool:
     raise OSError(err, os.strerror(err), str(b))
 
 
-def _pid_alive(pid: int) -> bool:
+# ------------------------------------------------------------ who is writing (lock files)
+#
+# A run holds an exclusive lock on its own lock file (``.NAME.microg-tmp-PID-TOKEN.lock``, an
+# empty sibling of its temporary directories) from before it creates them until after it has
+# removed them.  The operating system drops the lock when the process dies, however it dies,
+# so a temporary entry whose lock file exists and can be locked belongs to a run that is
+# over.  An entry without its lock file is not microg's and is left alone.  No process is
+# signalled or looked up by number.
+
+
+def _try_lock(fd: int) -> bool:
+    """Take an exclusive lock on an open file without waiting; False if another holds it."""
     try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
+        if os.name == "nt":  # pragma: no cover - Windows
+            import msvcrt
+
+            msvcrt.locking(fd, msvcrt.LK_NBLCK, 1)
+        else:
+            import fcntl
+
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
         return False
-    except PermissionError:
-        return True
     return True
 
 
+class _Lock:
+    """The lock file of one run into ``target``, held while the run writes."""
+
+    def __init__(self, target: Path) -> None:
+        token = f"{os.getpid()}-{secrets.token_hex(4)}"
+        self.stem = f".{target.name}{_TMP_TAG}{token}"
+        self.path = target.parent / f"{self.stem}.lock"
+        self.fd = os.open(self.path, os.O_CREAT | os.O_EXCL | os.O_RDWR, 0o600)
+        if not _try_lock(self.fd):  # pragma: no cover - a file only this process created
+            os.close(self.fd)
+            raise OSError(errno.EAGAIN, "cannot lock", str(self.path))
+
+    def release(self) -> None:
+        """Drop the lock and remove its file (again: nothing)."""
+        if self.fd < 0:
+            return
+        os.close(self.fd)
+        self.fd = -1
+        with contextlib.suppress(OSError):
+            self.path.unlink()
+
+
+def _writer_gone(lock: Path) -> bool:
+    """Whether ``lock`` is the lock file of a run that is over (an empty file, lock free)."""
+    try:
+        if lock.is_symlink() or not lock.is_file() or lock.stat().st_size:
+            return False
+        fd = os.open(lock, os.O_RDWR)
+    except OSError:
+        return False
+    try:
+        return _try_lock(fd)
+    finally:
+        os.close(fd)
+
+
 def _remove_stale(target: Path) -> None:
-    """Remove temporary siblings left by killed runs into ``target`` (dead process, marked)."""
+    """Remove the temporary siblings (and lock files) of runs into ``target`` that are over.
+
+    Only entries named as microg names its temporaries are touched: a temporary directory
+    is entirely microg's (it was created empty by the run and filled by it).
+    """
     prefix = f".{target.name}{_TMP_TAG}"
     try:
-        entries = list(os.scandir(target.parent))
+        entries = [e for e in os.scandir(target.parent) if e.name.startswith(prefix)]
     except OSError:
         return
     for entry in entries:
-        if not entry.name.startswith(prefix) or not entry.is_dir(follow_symlinks=False):
+        if entry.name.endswith(".lock") or not entry.is_dir(follow_symlinks=False):
             continue
-        pid_text = entry.name[len(prefix) :].split("-", 1)[0]
-        if not pid_text.isdigit() or _pid_alive(int(pid_text)):
-            continue
-        path = Path(entry.path)
-        with contextlib.suppress(OSError):
-            if _has_marker(path) or _is_empty_dir(path) or _only_partial(path):
-                _remove_run(path)
-
-
-def _only_partial(path: Path) -> bool:
-    """A temporary directory killed before its marker was written: it has a pending tag."""
-    return (path / f"{RUN_MARKER}.pending").is_file()
+        token = "-".join(entry.name[len(prefix) :].split("-")[:2])
+        lock = target.parent / f"{prefix}{token}.lock"
+        if _writer_gone(lock):
+            path = Path(entry.path)
+            if (path / RUN_MARKER).exists():  # a complete run, new or previous: its files
+                _remove_previous(path, target)
+            else:  # filled by the run before its marker: entirely microg's
+                shutil.rmtree(path, ignore_errors=True)
+    for entry in entries:
+        if entry.name.endswith(".lock") and entry.is_file(follow_symlinks=False):
+            path = Path(entry.path)
+            if _writer_gone(path):
+                with contextlib.suppress(OSError):
+                    path.unlink()
 
 
 class _Terminated(BaseException):
@@ -454,57 +628,58 @@ def write_run_directory(
     parent = target.parent
     created: list[Path] = [p for p in (parent, *parent.parents) if not p.exists()]
     tmp: Path | None = None
+    previous: Path | None = None
+    lock: _Lock | None = None
     with _sigterm_as_exception():
         try:
             parent.mkdir(parents=True, exist_ok=True)
             _remove_stale(target)
+            lock = _Lock(target)
             # the name is held before the directory exists: a SIGTERM between the two (an
             # exception at any bytecode) still finds it to remove (mkdtemp's return would not)
-            while True:
-                tmp = parent / f".{target.name}{_TMP_TAG}{os.getpid()}-{secrets.token_hex(4)}"
-                try:
-                    os.mkdir(tmp, 0o700)
-                    break
-                except FileExistsError:
-                    continue
-            (tmp / f"{RUN_MARKER}.pending").write_bytes(b"")
+            tmp = parent / lock.stem
+            os.mkdir(tmp, 0o700)
+            manifest: dict[str, str] = {}
             for name, content in files.items():
                 data = content.encode("utf-8") if isinstance(content, str) else bytes(content)
                 dest = tmp / name
                 dest.parent.mkdir(parents=True, exist_ok=True)
                 with open(dest, "xb") as fh:
                     fh.write(data)
-            marker = {"microg_run": 1, "files": sorted(files)}
-            (tmp / RUN_MARKER).write_text(json.dumps(marker) + "\n", encoding="utf-8")
-            (tmp / f"{RUN_MARKER}.pending").unlink()
+                manifest[Path(name).as_posix()] = hashlib.sha256(data).hexdigest()
+            marker = {"microg_run": _MANIFEST_VERSION, "files": dict(sorted(manifest.items()))}
+            (tmp / RUN_MARKER).write_text(json.dumps(marker, indent=1) + "\n", encoding="utf-8")
             os.chmod(tmp, 0o777 & ~_umask())
             if target.exists():
                 _check_replaceable(target, text, where)  # again, just before the swap
-                tmp = _swap(tmp, target)  # now holds the previous run (marked or empty)
-                _remove_run(tmp)
+                previous = _swap(tmp, target, lock.stem)
+                tmp = None  # the new run is in place; what is at `previous` was the old one
+                _remove_previous(previous, target)
+                previous = None
             else:
                 os.rename(tmp, target)
-            tmp = None
+                tmp = None
         except OSError as exc:
-            _cleanup(tmp, created)
+            _cleanup(tmp, previous, target, created, lock)
             raise InputError(
                 f"cannot write {exc.filename or target}: {exc.strerror or exc}",
                 where=where,
                 fix="choose a writable directory with free space",
             ) from None
         except BaseException:
-            _cleanup(tmp, created)
+            _cleanup(tmp, previous, target, created, lock)
             raise
+        finally:
+            if lock is not None:
+                lock.release()
     return target
 
 
-def _swap(new: Path, target: Path) -> Path:
+def _swap(new: Path, target: Path, stem: str) -> Path:
     """Put directory ``new`` at ``target``; return where the previous ``target`` now is."""
     if _exchange(new, target):
         return new
-    aside = Path(tempfile.mkdtemp(prefix=f".{target.name}{_TMP_TAG}{os.getpid()}-old-",
-                                  dir=target.parent))  # fmt: skip
-    os.rmdir(aside)
+    aside = target.parent / f"{stem}-old"
     os.rename(target, aside)
     try:
         os.rename(new, target)
@@ -514,33 +689,45 @@ def _swap(new: Path, target: Path) -> Path:
     return aside
 
 
-def _remove_run(path: Path) -> None:
-    """Delete a run directory, its marker last: a kill midway leaves it marked (removable)."""
-    tags = (RUN_MARKER, f"{RUN_MARKER}.pending")
-    for root, dirs, names in os.walk(path, topdown=False):
-        for name in names:
-            if not (root == str(path) and name in tags):
-                with contextlib.suppress(FileNotFoundError):
-                    os.unlink(os.path.join(root, name))
+def _remove_previous(path: Path, target: Path) -> None:
+    """Delete the previous run, now at ``path``: only the files its manifest lists.
+
+    Each listed file is removed only if it still has the recorded SHA-256, then the
+    directories left empty, the marker last.  Anything else (a file a user put there after
+    the check, a moment ago) is kept: the directory is then renamed to a visible sibling of
+    the target, ``NAME.microg-kept-TOKEN``, with it inside.
+    """
+    manifest = _manifest(path) or {}
+    for name, digest in manifest.items():
+        file = path / name
+        with contextlib.suppress(OSError):
+            if not file.is_symlink() and file.is_file() and _sha256(file) == digest:
+                file.unlink()
+    for root, dirs, _names in os.walk(path, topdown=False):
         for name in dirs:
-            full = os.path.join(root, name)
-            with contextlib.suppress(FileNotFoundError):
-                if os.path.islink(full):
-                    os.unlink(full)
-                else:
-                    os.rmdir(full)
-    for tag in tags:
-        with contextlib.suppress(FileNotFoundError):
-            (path / tag).unlink()
+            with contextlib.suppress(OSError):
+                os.rmdir(os.path.join(root, name))  # only if empty
+    files, other = _entries(path)
+    if not files and not other:
+        with contextlib.suppress(OSError):
+            (path / RUN_MARKER).unlink()
+        with contextlib.suppress(OSError):
+            path.rmdir()
+        return
     with contextlib.suppress(OSError):
-        path.rmdir()
-    if path.exists():  # anything unexpected: plain removal
-        shutil.rmtree(path, ignore_errors=True)
+        os.rename(path, target.parent / f"{target.name}.microg-kept-{secrets.token_hex(4)}")
 
 
-def _cleanup(tmp: Path | None, created: list[Path]) -> None:
+def _cleanup(
+    tmp: Path | None, previous: Path | None, target: Path, created: list[Path], lock: _Lock | None
+) -> None:
+    """After an error or a signal: the run's temporaries gone, the previous run's files too."""
     if tmp is not None:
-        _remove_run(tmp)
+        shutil.rmtree(tmp, ignore_errors=True)  # a temporary directory is entirely the run's
+    if previous is not None:  # interrupted while removing the replaced run
+        _remove_previous(previous, target)
+    if lock is not None:
+        lock.release()
     for p in created:  # deepest first
         with contextlib.suppress(OSError):
             p.rmdir()

@@ -150,13 +150,16 @@ def test_a_directory_microg_did_not_write_is_refused(tmp_path: Path, capsys) -> 
     assert rc == 2 and stdout == "" and "--out" in err and err.count("\n") == 1
     assert (out / "keep.txt").read_text() == "precious"
     assert (out / "figure3.png").read_bytes() == b"old"
-    # a directory microg wrote is replaced whole, with nothing stale left beside it
+    # a directory microg wrote is replaced whole, with nothing left beside it
     mine = tmp_path / "run"
     assert _run(capsys, ["reproduce", "--out", str(mine)])[0] == 0
-    (mine / "stale.png").write_bytes(b"old")
     assert _run(capsys, ["reproduce", "--out", str(mine)])[0] == 0
-    assert not (mine / "stale.png").exists()
     assert [p.name for p in mine.parent.iterdir() if p.name.startswith(".")] == []
+    # ... but a file a user added there is never deleted: the run is refused, naming it
+    (mine / "my-figure.png").write_bytes(b"mine")
+    rc, stdout, err = _run(capsys, ["reproduce", "--out", str(mine)])
+    assert rc == 2 and "my-figure.png" in err and err.count("\n") == 1
+    assert (mine / "my-figure.png").read_bytes() == b"mine"
 
 
 @pytest.mark.parametrize(

@@ -513,7 +513,7 @@ def _prepare_out(study: Study, out: Path) -> Path:
     from microg.models.toml import dump_station
     from microg.study.summary import model_file
 
-    target = check_writable(out, where="out")
+    target = check_writable(out, where="out", resumable=True)
     try:
         target.mkdir(parents=True, exist_ok=True)
         marker = {"microg_run": 1, "files": [STORE_NAME, "report.html", "models"],
