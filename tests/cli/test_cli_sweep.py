@@ -153,3 +153,52 @@ def test_a_scheduler_that_does_not_answer(study_file, tmp_path: Path, capsys) ->
     assert rc == 2 and err.startswith("microg: error: --scheduler:") and err.count("\n") == 1
     rc, _, err = _run(capsys, [*args, "--scheduler", "tcp://127.0.0.1:9", "--workers", "2"])
     assert rc == 2 and "--workers" in err
+
+
+class _SignalOnFirstBlock:
+    """A progress bar that sends the process a signal once the first block is written."""
+
+    def __init__(self, signum: int) -> None:
+        self.signum, self.n, self.sent = signum, 0, False
+
+    def update(self, k: int) -> None:
+        self.n += k
+        if k and not self.sent:
+            import os
+
+            self.sent = True
+            os.kill(os.getpid(), self.signum)
+
+    def close(self) -> None:
+        pass
+
+
+@pytest.mark.parametrize("name", ["SIGTERM", "SIGINT"])
+def test_a_signal_stop_is_never_success(name, study_file, tmp_path, capsys, monkeypatch) -> None:
+    # a batch system records the job by its status: 128 + the signal's number (143, 130),
+    # as a shell reports a process the signal ended; the blocks written stay and resume
+    import signal
+
+    signum = getattr(signal, name)
+    monkeypatch.setattr(
+        "microg.cli._progress.progress_bar", lambda *a, **k: _SignalOnFirstBlock(signum)
+    )
+    out = tmp_path / "out"
+    rc, _, err = _run(capsys, ["sweep", str(study_file), "--out", str(out), "--no-progress"])
+    assert rc == 128 + signum, err
+    assert "sweep stopped after" in err and "to resume" in err
+    monkeypatch.undo()
+    rc, _, err = _run(capsys, ["sweep", str(study_file), "--out", str(out), "--no-progress"])
+    assert rc == 0, err
+
+
+def test_a_failure_part_way_exits_1(study_file, tmp_path, capsys, monkeypatch) -> None:
+    from microg.study.run import SweepIncompleteError
+
+    def stop(*a, **k):
+        raise SweepIncompleteError("RuntimeError: disk", done_blocks=1, total_blocks=4,
+                                   done_cases=8, total_cases=32, store=None, resume="again")  # fmt: skip
+
+    monkeypatch.setattr("microg.study.run.sweep", stop)
+    rc, _, err = _run(capsys, ["sweep", str(study_file), "--out", str(tmp_path / "o")])
+    assert rc == 1 and "sweep stopped after 1 of 4 blocks" in err

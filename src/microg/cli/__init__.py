@@ -94,7 +94,7 @@ def main(argv: list[str] | None = None) -> int:
 def _run(argv: list[str] | None) -> int:
     """:func:`main`'s body: the command, every error turned into one line and a status."""
     try:
-        cli.main(args=argv, prog_name="microg", standalone_mode=False)
+        status = cli.main(args=argv, prog_name="microg", standalone_mode=False)
     except click.exceptions.NoSuchOption as exc:
         hint = f"; did you mean {', '.join(exc.possibilities)}?" if exc.possibilities else ""
         click.echo(f"microg: error: no such option {exc.option_name}{hint} (see --help)", err=True)
@@ -140,7 +140,8 @@ def _run(argv: list[str] | None) -> int:
             err=True,
         )
         return 3
-    return 0
+    # without standalone mode, click returns a command's ``Exit`` status instead of raising it
+    return status if isinstance(status, int) and not isinstance(status, bool) else 0
 
 
 def _command(argv: list[str] | None) -> str:

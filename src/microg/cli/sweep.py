@@ -129,7 +129,10 @@ def sweep(
     except SweepIncompleteError as exc:
         bar.close()
         click.echo(f"microg: error: {' '.join(str(exc).split())}", err=True)
-        raise click.exceptions.Exit(1) from None
+        # a stop is never a success: 128 + the signal's number (the shell's convention: 143
+        # for SIGTERM, 130 for Ctrl-C), 1 for a failure part-way
+        stop = 1 if exc.signal_number is None else 128 + int(exc.signal_number)
+        raise click.exceptions.Exit(stop) from None
     bar.close()
     from microg.environment.requirements import requirement
     from microg.report.study import figures, render_sweep

@@ -20,6 +20,7 @@ resume: run the same sweep into the same directory; finished blocks are not reco
 from __future__ import annotations
 
 import logging
+import signal
 from collections import deque
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
@@ -72,6 +73,8 @@ class SweepIncompleteError(MicrogError):
     done_blocks, total_blocks : blocks written and blocks of the plan
     done_cases, total_cases : the same in cases
     store : the store's path (None: in memory)
+    signal_number : the signal that stopped it (``signal.SIGTERM``, ``signal.SIGINT``), or
+        None when a failure stopped it; the CLI exits with 128 + this number, else 1
     """
 
     def __init__(
@@ -84,7 +87,9 @@ class SweepIncompleteError(MicrogError):
         total_cases: int,
         store: Path | None,
         resume: str,
+        signal_number: int | None = None,
     ):
+        self.signal_number = signal_number
         self.done_blocks, self.total_blocks = done_blocks, total_blocks
         self.done_cases, self.total_cases = done_cases, total_cases
         self.store = store
@@ -312,7 +317,7 @@ class _Runner:
             self.done_cases += blk.n_cases
             self.progress(self.done_cases, self.total_cases)
 
-    def stopped(self, cause: str) -> SweepIncompleteError:
+    def stopped(self, cause: str, signal_number: int | None = None) -> SweepIncompleteError:
         self.store.set_state("stopped", cause=cause)
         return SweepIncompleteError(
             cause,
@@ -322,6 +327,7 @@ class _Runner:
             total_cases=self.total_cases,
             store=self.store.path,
             resume=self.resume,
+            signal_number=signal_number,
         )
 
     def finish(self) -> None:
@@ -610,9 +616,10 @@ def sweep(
         store.set_state("stopped", cause="bad input")
         raise
     except _Terminated:
-        raise runner.stopped("terminated (SIGTERM: a batch system's time limit?)") from None
+        cause = "terminated (SIGTERM: a batch system's time limit?)"
+        raise runner.stopped(cause, signal.SIGTERM) from None
     except KeyboardInterrupt:
-        raise runner.stopped("interrupted") from None
+        raise runner.stopped("interrupted", signal.SIGINT) from None
     except Exception as exc:  # a failure part-way: keep what is written, say how to resume
         cause = f"{type(exc).__name__}: {' '.join(str(exc).split())[:300]}"
         raise runner.stopped(cause) from exc
