@@ -465,7 +465,7 @@ def _exchange(a: Path, b: Path) -> bool:
 def _try_lock(fd: int) -> bool:
     """Take an exclusive lock on an open file without waiting; False if another holds it."""
     try:
-        if os.name == "nt":  # pragma: no cover - Windows
+        if sys.platform == "win32":  # pragma: no cover - Windows
             import msvcrt
 
             msvcrt.locking(fd, msvcrt.LK_NBLCK, 1)

@@ -196,9 +196,47 @@ def test_a_failure_part_way_exits_1(study_file, tmp_path, capsys, monkeypatch) -
     from microg.study.run import SweepIncompleteError
 
     def stop(*a, **k):
-        raise SweepIncompleteError("RuntimeError: disk", done_blocks=1, total_blocks=4,
-                                   done_cases=8, total_cases=32, store=None, resume="again")  # fmt: skip
+        raise SweepIncompleteError(
+            "RuntimeError: disk", done_blocks=1, total_blocks=4, done_cases=8, total_cases=32,
+            store=None, resume="again",
+        )  # fmt: skip
 
     monkeypatch.setattr("microg.study.run.sweep", stop)
     rc, _, err = _run(capsys, ["sweep", str(study_file), "--out", str(tmp_path / "o")])
     assert rc == 1 and "sweep stopped after 1 of 4 blocks" in err
+
+
+def _edited_example(tmp_path: Path, old: str, new: str) -> Path:
+    example = Path(__file__).resolve().parents[2] / "examples" / "study.toml"
+    text = example.read_text(encoding="utf-8")
+    assert old in text
+    path = tmp_path / "study.toml"
+    path.write_text(text.replace(old, new, 1), encoding="utf-8")
+    return path
+
+
+@pytest.mark.parametrize(
+    "case",
+    [
+        # a scheduler that does not answer: refused before anything is written
+        ("scheduler", None, ["--scheduler", "tcp://127.0.0.1:1", "--timeout", "0.5"]),
+        # a record too coarse for the modes: found by the first modal solve
+        ("record", ('dt = "0.02 s"', 'dt = "5 s"'), []),
+        # a variant that moves the orbiter to 1e9 ft: the masses on one line, a mechanism,
+        # found by the second variant's solve after the first variant's blocks were written
+        ("variant", ('"-100 ft"]', '"-1e9 ft"]'), []),
+    ],
+    ids=lambda c: c[0],
+)
+def test_a_refused_sweep_leaves_nothing(case, tmp_path: Path, capsys) -> None:
+    _, edit, extra = case
+    example = Path(__file__).resolve().parents[2] / "examples" / "study.toml"
+    study = example if edit is None else _edited_example(tmp_path, *edit)
+    out = tmp_path / "sw"
+    rc, _, err = _run(capsys, ["sweep", str(study), "--out", str(out), "--no-progress", *extra])
+    assert rc == 2 and err.count("\n") == 1, err
+    assert not out.exists()
+    # an empty directory the user made stays, empty; a foreign file is never touched
+    out.mkdir()
+    rc, _, _ = _run(capsys, ["sweep", str(study), "--out", str(out), "--no-progress", *extra])
+    assert rc == 2 and out.is_dir() and list(out.iterdir()) == []

@@ -1,8 +1,8 @@
 """Tests of microg.dynamics.forces: Eq. 2.16, piecewise-linear histories, CSV files, specs, library.
 
 References: the report's Eq. 2.16 written out independently below; np.interp for linear
-interpolation; the magnitudes Klute measured on the KC-135 ("Pilot Investigation: Nominal Crew Induced
-Forces in Zero-G", SAE).
+interpolation; the magnitudes Klute measured on the KC-135 ("Pilot Investigation: Nominal
+Crew Induced Forces in Zero-G", SAE).
 """
 
 from __future__ import annotations

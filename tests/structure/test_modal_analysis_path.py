@@ -155,7 +155,8 @@ def test_modal_mass_of_an_imported_torsion_mode_counts_rotations():
     from microg.dynamics.modes import characteristic_length, solve_modes
     from microg.structure.discretize import discretize
 
-    path = Path(__file__).resolve().parents[1] / "data" / "nastran" / "beam_modes" / "beam_modes_m2.op2"
+    data = Path(__file__).resolve().parents[1] / "data" / "nastran"
+    path = data / "beam_modes" / "beam_modes_m2.op2"
     model = microg.load_model(path, units="in,lbf,s")
     s = discretize(model)
     m = solve_modes(s)

@@ -101,7 +101,8 @@ def test_pims_table_structure() -> None:
     assert np.allclose(c[:10], 2.0 ** (np.arange(-20, -10) / 3), rtol=0, atol=5.000001e-5)
     assert np.allclose(c[38:], 2.0 ** (np.arange(18, 26) / 3), rtol=0, atol=5e-3)
     # limits: 1.8 ug to the 0.1 Hz band, 18 x nominal centre ug from 0.125 Hz to 80.6 Hz,
-    # 1.8 mg from 101.6 Hz (PIMS's get_oto_iss_req_steps); PIMS rounds 18 x 80.635 = 1451.43 to 1451.4
+    # 1.8 mg from 101.6 Hz (PIMS's get_oto_iss_req_steps); PIMS rounds 18 x 80.635 = 1451.43
+    # to 1451.4
     assert np.all(lim[:11] == 1.8e-6) and np.all(lim[40:] == 1.8e-3)
     assert np.allclose(lim[11:40], 18e-6 * c[11:40], rtol=1e-4)
 

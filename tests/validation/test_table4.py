@@ -26,7 +26,8 @@ def test_bending_frequencies(rep, case: str) -> None:
 
 @pytest.mark.parametrize("case", ["xz_orbiter", "xz_no_orbiter", "yz_orbiter", "yz_no_orbiter"])
 def test_libration_frequencies(rep, case: str) -> None:
-    # Eq. 2.30 with Table 2's inertias and R = 6,870 km (1.89e-3 rad/s libration): within 0.2% of Table 4
+    # Eq. 2.30 with Table 2's inertias and R = 6,870 km (1.89e-3 rad/s libration): within 0.2%
+    # of Table 4
     lib = rep.table4[case].libration
     assert lib.omega == pytest.approx(lib.printed_omega, rel=2e-3)
 

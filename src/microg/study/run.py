@@ -19,6 +19,7 @@ resume: run the same sweep into the same directory; finished blocks are not reco
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import signal
 from collections import deque
@@ -510,6 +511,33 @@ class _Terminated(KeyboardInterrupt):
     """SIGTERM during a sweep (SLURM's and PBS's time limit): stop as on Ctrl-C, resumably."""
 
 
+def _is_new(out: Path) -> bool:
+    """Whether ``out`` is absent or an empty directory (a sweep may then remove all it wrote)."""
+    try:
+        return not out.exists() or (out.is_dir() and next(out.iterdir(), None) is None)
+    except OSError:
+        return False
+
+
+def _discard_fresh(target: Path, created: bool) -> None:
+    """Remove what a refused sweep wrote into a directory that was new or empty before it.
+
+    Only the sweep's own entries are removed (the marker, ``models/``, the store); the
+    directory itself only if this call created it and it is then empty.
+    """
+    import shutil
+
+    from microg._io import RUN_MARKER
+
+    for name in (STORE_NAME, "models"):
+        if (target / name).is_dir() and not (target / name).is_symlink():
+            shutil.rmtree(target / name, ignore_errors=True)
+    (target / RUN_MARKER).unlink(missing_ok=True)
+    if created:
+        with contextlib.suppress(OSError):
+            target.rmdir()  # only when empty: nothing of anyone else's is there
+
+
 def _prepare_out(study: Study, out: Path) -> Path:
     """Check the output directory (new, empty, or microg's), mark it, write derived models."""
     import json
@@ -593,36 +621,50 @@ def sweep(
         raise InputError(f"must be an integer from 1 to 1024, got {workers!r}", where="workers")
     if not (np.isfinite(timeout_s) and timeout_s > 0):
         raise InputError(f"must be > 0, got {timeout_s!r}", where="timeout")
-    out_dir = None if out is None else _prepare_out(study, Path(out))
-    store = SweepStore(study, None if out_dir is None else out_dir / STORE_NAME,
-                       restart=restart, where="out")  # fmt: skip
-    hint = resume_hint or (
-        f"call microg.sweep({study.file!r}, {str(out_dir)!r}) again"
-        if out_dir is not None
-        else "run the sweep again with an output directory"
-    )
-    runner = _Runner(study, store, progress, hint)
-    task_fn = _task_fn or run_blocks
-    runner.start()
-    try:
-        with sigterm_raises(_Terminated):
-            if runner.todo:
-                if workers is None and scheduler is None:
-                    _serial(runner, task_fn, threads)
-                else:
-                    with _client(workers, scheduler, timeout_s) as client:
+    # what can be checked is checked before the first write (each variant's model, the
+    # scheduler's answer); what only a variant's modal solve finds (a mechanism, a record too
+    # coarse for the modes) removes again what this call wrote into a new or empty directory
+    for im in range(len(study.models)):
+        for iv in range(len(study.variants)):
+            study.variant_model(im, iv)
+    with contextlib.ExitStack() as stack:
+        client = None
+        if workers is not None or scheduler is not None:
+            client = stack.enter_context(_client(workers, scheduler, timeout_s))
+        fresh = out is not None and _is_new(Path(out))
+        created = out is not None and not Path(out).exists()
+        out_dir = None if out is None else _prepare_out(study, Path(out))
+        store = SweepStore(study, None if out_dir is None else out_dir / STORE_NAME,
+                           restart=restart, where="out")  # fmt: skip
+        hint = resume_hint or (
+            f"call microg.sweep({study.file!r}, {str(out_dir)!r}) again"
+            if out_dir is not None
+            else "run the sweep again with an output directory"
+        )
+        runner = _Runner(study, store, progress, hint)
+        task_fn = _task_fn or run_blocks
+        try:
+            runner.start()
+            with sigterm_raises(_Terminated):
+                if runner.todo:
+                    if client is None:
+                        _serial(runner, task_fn, threads)
+                    else:
                         _distributed(runner, client, task_fn, threads)
-    except InputError:
-        store.set_state("stopped", cause="bad input")
-        raise
-    except _Terminated:
-        cause = "terminated (SIGTERM: a batch system's time limit?)"
-        raise runner.stopped(cause, signal.SIGTERM) from None
-    except KeyboardInterrupt:
-        raise runner.stopped("interrupted", signal.SIGINT) from None
-    except Exception as exc:  # a failure part-way: keep what is written, say how to resume
-        cause = f"{type(exc).__name__}: {' '.join(str(exc).split())[:300]}"
-        raise runner.stopped(cause) from exc
+        except InputError:
+            if fresh and out_dir is not None:  # all of it is this call's: nothing half-written
+                _discard_fresh(out_dir, created)
+            else:
+                store.set_state("stopped", cause="bad input")
+            raise
+        except _Terminated:
+            cause = "terminated (SIGTERM: a batch system's time limit?)"
+            raise runner.stopped(cause, signal.SIGTERM) from None
+        except KeyboardInterrupt:
+            raise runner.stopped("interrupted", signal.SIGINT) from None
+        except Exception as exc:  # a failure part-way: keep what is written, say how to resume
+            cause = f"{type(exc).__name__}: {' '.join(str(exc).split())[:300]}"
+            raise runner.stopped(cause) from exc
     runner.finish()
     return SweepResult(
         study=study,
