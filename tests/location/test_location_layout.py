@@ -221,10 +221,11 @@ def test_readme_example_gain_is_physical(carry):
     #         --movable "Horizontal lab=-91ft:-5ft"   (docs/locate.md adds both --carry)
     # An earlier version reported "1.162e-05 g -> 2.295e-37 g (x5.06e+31 lower)": the
     # objective left out the rigid-body acceleration.  The total now includes it, and is
-    # bounded below independently of the modes: at the jump of the push-off at t1 the acceleration jumps by
-    # f0 T_e M^-1 T_a^T (all modes of the model together, Phi Phi^T = M^-1), so the peak over
-    # a window holding both sides of the jump is at least half that (M from the moved
-    # station's own discretisation, not from the optimiser).
+    # bounded below independently of the modes: at the jump of the push-off at t1 the
+    # acceleration jumps by f0 T_e M^-1 T_a^T (all modes of the model together,
+    # Phi Phi^T = M^-1), so the peak over a window holding both sides of the jump is at
+    # least half that (M from the moved station's own discretisation, not from the
+    # optimiser).
     station = load_station("ioc")
     res = optimize_layout(
         station, "lab", "crew", movable={"Horizontal lab": ("-91 ft", "-5 ft")}, carry=carry

@@ -2,7 +2,8 @@
 
 Fixtures (tests/data/nastran/): beam_modes/beam_modes_m2.op2 + beam_modes.f06, a Simcenter
 Nastran SOL 103 run (pyNastran models/, BSD, LICENSE-pyNastran.md); cla_residual.op2, a
-free-free SOL 103 residual run with a CORD2R output system (pyyeti tests/cla_test_data_2020, LICENSE-pyyeti.txt).
+free-free SOL 103 residual run with a CORD2R output system (pyyeti
+tests/cla_test_data_2020, LICENSE-pyyeti.txt).
 """
 
 from __future__ import annotations
