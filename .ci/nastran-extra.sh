@@ -11,7 +11,7 @@ VENV=$(mktemp -d)/venv-nastran
 source "$VENV/bin/activate"
 python -m pip install --quiet --upgrade pip
 python -m pip install --quiet "numpy<2" "pyNastran==1.4.1" "pyyeti>=1.4.7" "pyuff>=2.4" \
-  pytest hypothesis
+  pytest pytest-timeout hypothesis
 python -m pip install --quiet --no-deps -e . && python -m pip install --quiet .
 python -c "import numpy, pyNastran; print('nastran extra env: numpy', numpy.__version__, 'pyNastran', pyNastran.__version__)"
 if python -m pytest --markers 2>/dev/null | grep -q "@pytest.mark.nastran"; then
