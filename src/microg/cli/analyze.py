@@ -17,6 +17,7 @@ import click
 
 from microg.analysis import DEFAULTS
 from microg.cli._errors import flag_errors
+from microg.cli.params import PathType, PositiveFloat
 
 __all__ = ["analyze", "flag_errors", "write_outputs"]
 
@@ -176,11 +177,16 @@ def _weight_to_mass(text: str) -> str:
     help="Add a vibration absorber of this mass ratio to the report-rule mount.",
 )
 @click.option("--units", default=None, help="Units of a NASTRAN/UFF model: 'LENGTH,FORCE,TIME'.")
-@click.option("--wtmass", type=float, default=None, help="NASTRAN PARAM WTMASS of the run.")
+@click.option(
+    "--wtmass",
+    type=PositiveFloat(),
+    default=None,
+    help="NASTRAN PARAM WTMASS of the run (a deck's own PARAM WTMASS must agree).",
+)
 @click.option(
     "--points",
     "points_file",
-    type=click.Path(dir_okay=False, path_type=Path),
+    type=PathType(dir_okay=False, path_type=Path),
     default=None,
     help='TOML file naming grids of an imported model (lab = "grid:2001", with kinds).',
 )
@@ -194,7 +200,7 @@ def _weight_to_mass(text: str) -> str:
 @click.option(
     "--out",
     "out_dir",
-    type=click.Path(file_okay=False, path_type=Path),
+    type=PathType(file_okay=False, path_type=Path),
     default=Path("microg-analysis"),
     show_default=True,
     help="Directory for report.html, figures and results.json (replaced as a whole).",
@@ -262,7 +268,11 @@ def analyze(
         kwargs["package_mass"] = package_mass
     stages = ["structure", "modes", "response", "assessment", "isolation", "report"]
     command = "microg " + " ".join(shlex.quote(a) for a in sys.argv[1:])
-    reader = {k: v for k, v in (("units", units), ("wtmass", wtmass), ("points", points_file)) if v}
+    reader = {
+        k: v
+        for k, v in (("units", units), ("wtmass", wtmass), ("points", points_file))
+        if v is not None
+    }
     with flag_errors(FLAGS), contextlib.ExitStack() as stack:
         # the figure helper forks first: a visible progress bar runs a monitor thread, and a
         # process with threads does not fork (microg.report.render)

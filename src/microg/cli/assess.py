@@ -10,7 +10,7 @@ from typing import Any
 
 import click
 
-from microg.cli.params import QuantityType
+from microg.cli.params import PathType, QuantityType
 
 __all__ = ["assess", "merge_assessments", "run_assessment"]
 
@@ -26,7 +26,7 @@ FLAGS = {
 
 
 @click.command()
-@click.argument("file", type=click.Path(path_type=Path))
+@click.argument("file", type=PathType(path_type=Path))
 @click.option(
     "--interval",
     type=QuantityType("time", "s", minimum=0.0, strict=True),
@@ -71,7 +71,7 @@ FLAGS = {
 @click.option(
     "--out",
     "out_dir",
-    type=click.Path(file_okay=False, path_type=Path),
+    type=PathType(file_okay=False, path_type=Path),
     default=None,
     help="Also write results.json and the figures into this directory.",
 )

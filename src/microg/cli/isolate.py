@@ -13,7 +13,7 @@ import click
 import numpy as np
 
 from microg._io import dumps
-from microg.cli.params import BandType, PositiveFloat, QuantityType, RangeType
+from microg.cli.params import BandType, PathType, PositiveFloat, QuantityType, RangeType
 from microg.units import LBF
 
 __all__ = ["isolate"]
@@ -273,7 +273,7 @@ def claims(mu_max: float, as_json: bool) -> None:
 @isolate.command()
 @click.option(
     "--out",
-    type=click.Path(dir_okay=False),
+    type=PathType(dir_okay=False),
     default="figure8.png",
     show_default=True,
     help="PNG file to write (atomically)",

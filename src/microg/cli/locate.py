@@ -20,7 +20,7 @@ import click
 import numpy as np
 
 from microg._io import dumps
-from microg.cli.params import PositiveFloat, QuantityType
+from microg.cli.params import PathType, PositiveFloat, QuantityType
 from microg.errors import InputError
 from microg.location.amap import DEFAULTS as LOCATE_DEFAULTS
 from microg.location.layout import DEFAULTS as LAYOUT_DEFAULTS
@@ -273,11 +273,16 @@ def _unit_system(station: Any, model: str) -> str | None:
 @click.option(
     "--units", default=None, help="Units of a NASTRAN/UFF model file: 'LENGTH,FORCE,TIME'."
 )
-@click.option("--wtmass", type=float, default=None, help="NASTRAN PARAM WTMASS of the run.")
+@click.option(
+    "--wtmass",
+    type=PositiveFloat(),
+    default=None,
+    help="NASTRAN PARAM WTMASS of the run (a deck's own PARAM WTMASS must agree).",
+)
 @click.option(
     "--points",
     "points_file",
-    type=click.Path(dir_okay=False, path_type=Path),
+    type=PathType(dir_okay=False, path_type=Path),
     default=None,
     help='TOML file naming grids of an imported model (crew = "grid:55").',
 )
@@ -285,7 +290,7 @@ def _unit_system(station: Any, model: str) -> str | None:
 @click.option(
     "--out",
     "out_dir",
-    type=click.Path(file_okay=False, path_type=Path),
+    type=PathType(file_okay=False, path_type=Path),
     default=None,
     help="Write OUT/map.json and OUT/map.png.",
 )

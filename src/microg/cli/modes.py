@@ -12,6 +12,8 @@ from typing import Any
 
 import click
 
+from microg.cli.params import PathType, PositiveFloat
+
 __all__ = ["modes"]
 
 FLAGS = {
@@ -94,17 +96,22 @@ def _effective_percent(m: Any) -> dict[str, Any]:
     "Appendix B does; the default is the free-free structure.",
 )
 @click.option("--units", default=None, help="Units of a NASTRAN/UFF file: 'LENGTH,FORCE,TIME'.")
-@click.option("--wtmass", type=float, default=None, help="NASTRAN PARAM WTMASS of the run.")
+@click.option(
+    "--wtmass",
+    type=PositiveFloat(),
+    default=None,
+    help="NASTRAN PARAM WTMASS of the run (a deck's own PARAM WTMASS must agree).",
+)
 @click.option(
     "--points",
-    type=click.Path(dir_okay=False, path_type=Path),
+    type=PathType(dir_okay=False, path_type=Path),
     default=None,
     help='TOML file naming grids of an imported model (lab = "grid:2001").',
 )
 @click.option(
     "--uff",
     "uff_out",
-    type=click.Path(dir_okay=False, path_type=Path),
+    type=PathType(dir_okay=False, path_type=Path),
     default=None,
     help="Also write the modes as UFF datasets 15+55 (+164 units) to this file.",
 )
@@ -139,7 +146,7 @@ def modes(
     import numpy as np
 
     import microg
-    from microg._io import dumps
+    from microg._io import check_writable, dumps
     from microg.cli._errors import flag_errors
     from microg.cli._load import load_model
     from microg.errors import InputError
@@ -149,7 +156,10 @@ def modes(
         raise InputError("applies to --method fem only", where="--elements")
     if method == "fem" and functions is not None:
         raise InputError("applies to --method ritz only", where="--functions")
-    options = {k: v for k, v in (("units", units), ("wtmass", wtmass), ("points", points)) if v}
+    if uff_out is not None:  # before any work: a file that cannot be written is bad input
+        uff_out = check_writable(uff_out, where="--uff", directory=False)
+    given = (("units", units), ("wtmass", wtmass), ("points", points))
+    options = {k: v for k, v in given if v is not None}
     with flag_errors(FLAGS):
         mdl = load_model(model, method, **options)
         fem_plane = method == "fem" and plane != "3d"

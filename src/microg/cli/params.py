@@ -14,7 +14,14 @@ import click
 from microg.errors import InputError
 from microg.units import G0, LIMITS, check_limit, parse_quantity
 
-__all__ = ["QuantityType", "MassOrWeightType", "RangeType", "BandType", "PositiveFloat"]
+__all__ = [
+    "QuantityType",
+    "MassOrWeightType",
+    "RangeType",
+    "BandType",
+    "PositiveFloat",
+    "PathType",
+]
 
 
 class QuantityType(click.ParamType):
@@ -190,3 +197,20 @@ class BandType(click.ParamType):
         if not (0 <= lo < hi) or not math.isfinite(hi):
             self.fail(f"need 0 <= LO < HI < inf, got {value!r}", param, ctx)
         return (lo, hi)
+
+
+class PathType(click.Path):
+    """click's path type, refusing first what the operating system cannot take.
+
+    An empty name or one holding a NUL character is refused in one line (``os.stat`` raises
+    ``ValueError`` on a NUL, which click does not catch); everything else is click's own check.
+    """
+
+    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
+        """The path of ``value``, after the empty-name and NUL checks."""
+        text = value if isinstance(value, str) else str(value)
+        if not text.strip():
+            self.fail("is empty: name a file or directory", param, ctx)
+        if "\x00" in text:
+            self.fail("holds a NUL character: name a plain file or directory", param, ctx)
+        return super().convert(value, param, ctx)

@@ -12,6 +12,7 @@ from typing import Any
 
 import click
 
+from microg.cli.params import PathType
 from microg.errors import InputError
 
 __all__ = ["quasi_steady", "FLAGS"]
@@ -148,7 +149,7 @@ def _vector(text: str | None, where: str, *, accel: bool = False) -> list[float]
 @click.option(
     "--out",
     "out_dir",
-    type=click.Path(file_okay=False, path_type=Path),
+    type=PathType(file_okay=False, path_type=Path),
     default=None,
     help="Directory for quasi-steady.json, the map (CSV) and its figure (replaced as a whole).",
 )

@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 
 import click
 
-from microg.cli.params import QuantityType
+from microg.cli.params import PathType, QuantityType
 from microg.seed.ioc import CASES
 
 if TYPE_CHECKING:
@@ -34,7 +34,7 @@ class _RecordedCommand(click.Command):
 @click.option(
     "--out",
     "out_dir",
-    type=click.Path(file_okay=False, path_type=Path),
+    type=PathType(file_okay=False, path_type=Path),
     default=Path("microg-reproduce"),
     show_default=True,
     help="Directory written as a whole: report.html (self-contained), results.json, "

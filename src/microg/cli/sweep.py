@@ -14,6 +14,7 @@ from pathlib import Path
 import click
 
 from microg.cli._errors import flag_errors
+from microg.cli.params import PathType
 
 __all__ = ["sweep"]
 
@@ -29,11 +30,11 @@ FLAGS = {
 
 
 @click.command()
-@click.argument("study_file", metavar="STUDY.toml", type=click.Path(path_type=Path))
+@click.argument("study_file", metavar="STUDY.toml", type=PathType(path_type=Path))
 @click.option(
     "--out",
     "out_dir",
-    type=click.Path(file_okay=False, path_type=Path),
+    type=PathType(file_okay=False, path_type=Path),
     default=Path("microg-sweep"),
     show_default=True,
     help="Directory for results.zarr (written as the sweep goes; resumed if it holds this "

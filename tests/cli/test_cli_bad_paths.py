@@ -1,0 +1,51 @@
+"""Paths and plain numbers the operating system or the model cannot take: one line, exit 2."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from microg.cli import main
+
+OP2 = Path(__file__).resolve().parents[1] / "data" / "nastran" / "beam_modes" / "beam_modes_m2.op2"
+
+
+def _run(capsys, args: list[str]) -> tuple[int, str]:
+    rc = main(args)
+    return rc, capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    "args",
+    [
+        ["analyze", "ioc", "--out", "a\x00b"],
+        ["quasi-steady", "ioc", "--out", "a\x00b"],
+        ["assess", "a\x00b"],
+        ["reproduce", "--out", "a\x00b"],
+        ["sweep", "study.toml", "--out", "a\x00b"],
+        ["locate", "ioc", "--out", "a\x00b"],
+        ["modes", "ioc", "--uff", "a\x00b.unv"],
+    ],
+    ids=lambda a: a[0],
+)
+def test_a_nul_in_a_path_is_one_line(args, capsys, tmp_path, monkeypatch) -> None:
+    # os.stat raises ValueError on a NUL, which click does not catch (it was exit 3)
+    monkeypatch.chdir(tmp_path)
+    rc, err = _run(capsys, args)
+    assert rc == 2 and "NUL" in err and err.count("\n") == 1, err
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("target", ["", "   ", "/proc/x.unv"])
+def test_an_unwritable_uff_file_is_refused_before_the_solve(target, capsys) -> None:
+    # '' used to be renamed onto '.', /proc/x.unv failed after the solve (exit 3 both)
+    rc, err = _run(capsys, ["modes", "ioc", "--uff", target])
+    assert rc == 2 and err.startswith("microg: error: --uff:") and err.count("\n") == 1, err
+
+
+@pytest.mark.parametrize("value", ["nan", "inf", "0", "-1"])
+def test_wtmass_must_be_a_positive_finite_number(value, capsys) -> None:
+    # 0 was taken as "not given", nan was accepted
+    rc, err = _run(capsys, ["modes", str(OP2), "--units", "in,lbf,s", "--wtmass", value])
+    assert rc == 2 and err.startswith("microg: error: --wtmass:"), err
