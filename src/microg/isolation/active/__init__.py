@@ -1,0 +1,1 @@
+"""Active isolation (placeholder, filled below)."""
