@@ -154,9 +154,17 @@ def poles_stable(system: Any) -> tuple[bool, float]:
 
 
 def loop_margins(
-    plant: ActivePlant, controller: Controller, *, discrete: bool = False, pade_order: int = 3
-) -> list[LoopMargin]:
-    """Margins of each loop broken at its actuator, the other five closed (module docstring)."""
+    plant: ActivePlant,
+    controller: Controller,
+    *,
+    discrete: bool = False,
+    pade_order: int = 3,
+    freq_hz: np.ndarray | None = None,
+) -> tuple[list[LoopMargin], np.ndarray]:
+    """Margins of each loop broken at its actuator, the other five closed (module docstring).
+
+    Returns the margins and each loop's response ``L_i`` at ``freq_hz`` (6, nf), complex.
+    """
     import control as ct
 
     gen = plant.generalized(pade_order, discrete=discrete)
@@ -168,12 +176,16 @@ def loop_margins(
     f_top = 0.499 * plant.sample_rate_hz if discrete else 20.0 * plant.sample_rate_hz
     omega = 2 * math.pi * np.geomspace(MARGIN_F_LO_HZ, f_top, MARGIN_POINTS)
     out = []
+    fr = np.asarray(freq_hz if freq_hz is not None else [], float)
+    resp = np.zeros((6, fr.size), complex)
     for i, name in enumerate(DOF_NAMES):
         e = np.eye(6)
         e[i, i] = 0.0
         closed = ct.feedback(h, gain(e, dt), sign=1)
         li = -(_select(6, [i], dt) * closed * _inputs(6, [i], dt))
         gm, pm, wgc, wpc = loop_margin_values(li, omega)
+        if fr.size:
+            resp[i] = _fresp(li, fr)[0, 0]
         out.append(
             LoopMargin(
                 loop=name,
@@ -184,7 +196,7 @@ def loop_margins(
                 phase_crossover_hz=_freq(wpc),
             )
         )
-    return out
+    return out, resp
 
 
 def _num(v: Any) -> float:
