@@ -73,6 +73,10 @@ GM_MIN = 2.0
 DESIGN_MARGIN = 0.8
 #: the acceleration loop's high-pass sits this fraction of the isolation corner
 LEAK_RATIO = 0.1
+#: H2 synthesis: least accelerometer noise relative to the base level, and least position
+#: noise (m/sqrt(Hz)) (conditioning of the filter Riccati equation)
+SYNTH_NOISE_RATIO = 0.03
+SYNTH_POSITION_NOISE_M = 1e-4
 #: least centring, rad/s (keeps a platform without umbilical stiffness centred)
 OMEGA_P_MIN = 2 * math.pi * 1e-4
 
@@ -364,7 +368,8 @@ def design_h2(plant: ActivePlant, target: Target, *, pade_order: int = 3) -> Con
     Performance outputs: the platform's linear acceleration through a band-pass over the
     target's span (weight 1 / 1e-6 g), the relative translation over the rattlespace and the
     actuator force over its limit; exogenous inputs: the base acceleration (1e-4 g, white), the
-    sensors' noises at their PSDs, and a small direct measurement noise (the synthesis needs a
+    sensors' noises at their PSDs (with floors, :data:`SYNTH_NOISE_RATIO`), and a direct
+    measurement noise (the synthesis needs a
     full-rank ``D21``).  The plant's accelerometer bandwidth must be finite (``D22 = 0``).
 
     Parameters
@@ -405,8 +410,10 @@ def design_h2(plant: ActivePlant, target: Target, *, pade_order: int = 3) -> Con
     ysel = np.hstack([np.zeros((12, 18)), np.eye(12)])
     outs = ct.append(zsys, gain(np.eye(12))) * gain(np.vstack([np.eye(30), ysel]))
     a0_w = 1e-4 * G0
-    na_w = math.sqrt(max(plant.accel_noise_psd, (1e-9 * G0) ** 2))
-    np_w = math.sqrt(max(plant.position_noise_psd, 1e-18))
+    # the synthesis' noise intensities have floors (the filter Riccati equation is not solved
+    # for sensor noise 1e-3 of the base level); the verification uses the plant's real noise
+    na_w = max(math.sqrt(plant.accel_noise_psd), SYNTH_NOISE_RATIO * a0_w)
+    np_w = max(math.sqrt(plant.position_noise_psd), SYNTH_POSITION_NOISE_M)
     # synthesis inputs [a0, n_a, n_p, u] (d is left out: it feeds the acceleration directly)
     gen_w = gen * gain(_exo_map(a0_w, na_w, np_w))
     full = outs * gen_w
