@@ -73,9 +73,27 @@ def _target(plant: ActivePlant, target: Any, preset_target: str | None) -> Targe
     raise InputError(f"unknown target {target!r}", where="target", fix="use g-limit, aris or a band map")
 
 
+#: a designed controller whose coupled (6-DOF) loop is unstable is designed again with the
+#: acceleration loops' ceiling halved, at most this many times
+BACK_OFF = 12
+
+
 def _controller(plant: ActivePlant, kind: str, target: Target, pade_order: int) -> Controller:
     if kind == "designed":
-        return design_feedback(plant, target, pade_order=pade_order)
+        # the channels are designed one by one; the coupling (centre of mass off the umbilicals'
+        # attachment) can destabilise the whole: back off the loop gain until it is stable
+        ctrl = design_feedback(plant, target, pade_order=pade_order)
+        for _ in range(BACK_OFF):
+            if verify.poles_stable(verify.closed_loop(plant, ctrl, pade_order=pade_order))[0]:
+                return ctrl
+            assert ctrl.omega_a is not None
+            ceiling = float(ctrl.omega_a.min()) / (4 * math.pi)
+            trial = design_feedback(plant.with_(max_loop_hz=ceiling), target, pade_order=pade_order)
+            ctrl = Controller(
+                trial.kind, trial.system, trial.omega_a, trial.omega_p,
+                (*trial.notes, f"the coupled loop was unstable: loops backed off to {ceiling:.3g} Hz"),
+            )
+        return ctrl
     if kind == "off":
         return no_controller()
     if kind == "h2":

@@ -138,7 +138,15 @@ def closed_loop(
     plant, controller : the isolator
     discrete : the sampled model instead of the continuous one
     pade_order : order of the delay's Pade approximant (continuous model)
+
+    With the controller off (``u = 0``) the continuous loop is the platform on its umbilicals
+    alone (12 states): the sensors and the delay carry nothing to the platform.
     """
+    if controller.kind == "off" and not discrete:
+        # u = 0: the platform on its umbilicals alone (the sensors and the delay carry nothing)
+        feed = np.zeros((15, 21))
+        feed[:9, :9] = np.eye(9)
+        return plant.physical() * gain(feed)
     gen = plant.generalized(pade_order, discrete=discrete)
     k = _controller(plant, controller, discrete)
     return gen.lft(k, nu=6, ny=12)
