@@ -105,8 +105,16 @@ def test_sampling_below_the_target_band_is_refused() -> None:
 
 def test_result_contract(aris) -> None:
     d = json.loads(json.dumps(aris.to_dict(), allow_nan=False))
-    for key in ("stable", "margins", "frequency_hz", "transmissibility", "plant", "target",
-                "meets_target", "binding_limit"):
+    for key in (
+        "stable",
+        "margins",
+        "frequency_hz",
+        "transmissibility",
+        "plant",
+        "target",
+        "meets_target",
+        "binding_limit",
+    ):
         assert key in d
     assert set(d["transmissibility"]) == {"x", "y", "z"}
     assert d["plant"]["umbilical"]["k_N_per_m"]["x"] == 300.0
@@ -128,14 +136,29 @@ def test_cli_json_contract(capsys) -> None:
     assert main(["isolate", "active", "--preset", "g-limit", "--no-station", "--json"]) == 0
     d = _strict(capsys.readouterr().out)
     assert d["stable"] is True and d["binding_limit"] is None and d["meets_target"] is True
-    assert d["plant"]["mass_kg"] == 20.0 and len(d["transmissibility"]["x"]) == len(d["frequency_hz"])
+    assert d["plant"]["mass_kg"] == 20.0 and len(d["transmissibility"]["x"]) == len(
+        d["frequency_hz"]
+    )
 
 
 def test_cli_off_is_passive(capsys) -> None:
     # the g-limit preset's centre of mass is at the umbilicals' attachment: no rocking coupling
-    args = ["isolate", "active", "--preset", "g-limit", "--no-station", "--controller", "off",
-            "--json", "--umbilical-stiffness", "300 N/m", "--umbilical-damping", "20 N*s/m",
-            "--mass", "700 kg"]
+    args = [
+        "isolate",
+        "active",
+        "--preset",
+        "g-limit",
+        "--no-station",
+        "--controller",
+        "off",
+        "--json",
+        "--umbilical-stiffness",
+        "300 N/m",
+        "--umbilical-damping",
+        "20 N*s/m",
+        "--mass",
+        "700 kg",
+    ]
     assert main(args) == 0
     d = _strict(capsys.readouterr().out)
     f = np.array(d["frequency_hz"])
@@ -166,7 +189,15 @@ def test_cli_bad_input_one_line_exit_2(args, name, capsys, tmp_path) -> None:
 
 def test_cli_out_writes_page_and_figures(tmp_path, capsys) -> None:
     out = tmp_path / "run"
-    assert main(["isolate", "active", "--no-station", "--preset", "g-limit", "--out", str(out)]) == 0
+    assert (
+        main(["isolate", "active", "--no-station", "--preset", "g-limit", "--out", str(out)]) == 0
+    )
     names = {p.name for p in out.iterdir()}
-    assert {"report.html", "result.json", "transmissibility.png", "noise.png", "margins.png"} <= names
+    assert {
+        "report.html",
+        "result.json",
+        "transmissibility.png",
+        "noise.png",
+        "margins.png",
+    } <= names
     _strict((out / "result.json").read_text())

@@ -15,7 +15,7 @@ import pytest
 pytest.importorskip("control")
 
 from microg.isolation.active import verify  # noqa: E402
-from microg.isolation.active.controller import feedback_controller, leak, Controller, no_controller  # noqa: E402
+from microg.isolation.active.controller import Controller, feedback_controller, leak, no_controller  # noqa: E402
 from microg.isolation.active.plant import ActivePlant  # noqa: E402
 
 

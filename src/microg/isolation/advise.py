@@ -293,7 +293,7 @@ def _active_check(
             requirement=requirement,
         )
     except InputError as exc:
-        return None, f"the {ACTIVE_PRESET.upper()}-class active isolator could not be designed ({exc})"
+        return None, f"the {ACTIVE_PRESET.upper()}-class active isolator could not be designed ({exc})"  # noqa: E501
     tm = act.time
     stroke = float(tm.peak_stroke[:3].max()) if tm is not None else float("nan")
     force = float(tm.peak_force[:3].max()) if tm is not None else float("nan")

@@ -38,7 +38,9 @@ def _transmissibility(res: ActiveIsolation, ax: Any) -> Figure:
     t = res.transmissibility_axis()
     for i, a in enumerate(_AXES):
         ax.loglog(f, t[i], lw=1.4, label=f"active, {a}")
-    ax.loglog(f, np.abs(res.passive[0, 0]), "k--", lw=0.9, label="umbilicals only (controller off), x")
+    ax.loglog(
+        f, np.abs(res.passive[0, 0]), "k--", lw=0.9, label="umbilicals only (controller off), x"
+    )
     lim = res.target.limit(f)
     fin = np.isfinite(lim)
     if fin.sum() > 1:
@@ -67,8 +69,15 @@ def _noise(res: ActiveIsolation, ax: Any) -> Figure:
     tm = res.time
     if tm is not None:
         to = tm.isolated.third_octave
-        ax.loglog(to.center_hz, to.rms_g.max(axis=0), "s-", ms=3, color="k", lw=1.0,
-                  label="isolated platform (time domain), worst axis")
+        ax.loglog(
+            to.center_hz,
+            to.rms_g.max(axis=0),
+            "s-",
+            ms=3,
+            color="k",
+            lw=1.0,
+            label="isolated platform (time domain), worst axis",
+        )
     ax.set_xlabel("1/3-octave band centre (Hz)")
     ax.set_ylabel("band RMS (g)")
     ax.set_title("noise floor the sensors put on the platform")
@@ -90,7 +99,13 @@ def _time(res: ActiveIsolation, ax: Any) -> Figure:
         axs = list(fig.subplots(3, 1, sharex=True))
     t = tm.timepts
     j = int(np.argmax(np.max(np.abs(tm.base_accel), axis=1)))
-    axs[0].plot(t, tm.base_accel[j] / G0 * 1e6, lw=0.8, color="0.5", label=f"station at {tm.point}, {_AXES[j]}")
+    axs[0].plot(
+        t,
+        tm.base_accel[j] / G0 * 1e6,
+        lw=0.8,
+        color="0.5",
+        label=f"station at {tm.point}, {_AXES[j]}",
+    )
     axs[0].plot(t, tm.platform_accel[j] / G0 * 1e6, lw=1.0, label=f"platform, {_AXES[j]}")
     axs[0].set_ylabel("acceleration (micro-g)")
     axs[0].legend(fontsize=8)
@@ -129,7 +144,9 @@ def _margins(res: ActiveIsolation, ax: Any) -> Figure:
     if cont:
         pm = min(m.phase_margin_deg for m in cont)
         gm = min(m.gain_margin_factor for m in cont)
-        ax.set_title(f"Nyquist, each loop broken (others closed): PM >= {pm:.3g} deg, GM >= {20 * np.log10(gm):.3g} dB")
+        ax.set_title(
+            f"Nyquist, each loop broken (others closed): PM >= {pm:.3g} deg, GM >= {20 * np.log10(gm):.3g} dB"  # noqa: E501
+        )
     else:
         ax.set_title("controller off: no loop")
     ax.grid(True, alpha=0.3)
@@ -145,13 +162,23 @@ def _bands(res: ActiveIsolation, ax: Any) -> Figure:
         return fig
     to = tm.isolated.third_octave
     bo = tm.base.third_octave
-    ax.loglog(bo.center_hz, bo.rms_g.max(axis=0), "o-", ms=3, color="0.5", label=f"station at {tm.point}")
+    ax.loglog(
+        bo.center_hz, bo.rms_g.max(axis=0), "o-", ms=3, color="0.5", label=f"station at {tm.point}"
+    )
     ax.loglog(to.center_hz, to.rms_g.max(axis=0), "s-", ms=3, label="platform, time domain")
-    ax.loglog(to.center_hz, tm.spectral_rms_g.max(axis=0)[: to.center_hz.size], "x", ms=5, label="platform, frequency domain")
+    ax.loglog(
+        to.center_hz,
+        tm.spectral_rms_g.max(axis=0)[: to.center_hz.size],
+        "x",
+        ms=5,
+        label="platform, frequency domain",
+    )
     ax.step(to.center_hz, to.limit_g, where="mid", color="crimson", lw=1.4, label="requirement")
     ax.set_xlabel("1/3-octave band centre (Hz)")
     ax.set_ylabel("band RMS, worst axis (g)")
-    ax.set_title(f"band verdict: {'complies' if tm.complies else 'does not comply'} (noise included)")
+    ax.set_title(
+        f"band verdict: {'complies' if tm.complies else 'does not comply'} (noise included)"
+    )
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
     return fig

@@ -1,3 +1,4 @@
+# ruff: noqa: E501  (the page template's HTML lines)
 """The HTML page of ``microg isolate active --out DIR``: the verdict, the margins, the figures.
 
 Self-contained (figures as data URIs); it computes nothing, it formats
@@ -52,22 +53,22 @@ def render_active(res: ActiveIsolation, figures: dict[str, bytes]) -> str:
         else ""
     )
     return f"""<!doctype html>
-<html lang="en"><head><meta charset="utf-8"><title>microg isolate active: {escape(plant['name'])}</title>
+<html lang="en"><head><meta charset="utf-8"><title>microg isolate active: {escape(plant["name"])}</title>
 <style>body{{font-family:sans-serif;max-width:60em;margin:1em auto}}table{{border-collapse:collapse}}
 td,th{{border:1px solid #ccc;padding:2px 6px;font-size:90%}}img{{max-width:100%}}</style></head>
-<body><h1>Active isolation: {escape(plant['name'])}, {escape(d['controller']['kind'])} controller</h1>
-<p><b>The design {verdict}</b> ({escape(d['target']['name'])}: {escape(d['target']['source'])});
-stable: {d['stable']}; binding limit: {escape(str(d['binding_limit']))}{extra}.</p>
-<p>Attenuation at 0.1 Hz: {', '.join(f'{a} {_num(v)}x' for a, v in d['attenuation_at_0_1_hz'].items())}.</p>
+<body><h1>Active isolation: {escape(plant["name"])}, {escape(d["controller"]["kind"])} controller</h1>
+<p><b>The design {verdict}</b> ({escape(d["target"]["name"])}: {escape(d["target"]["source"])});
+stable: {d["stable"]}; binding limit: {escape(str(d["binding_limit"]))}{extra}.</p>
+<p>Attenuation at 0.1 Hz: {", ".join(f"{a} {_num(v)}x" for a, v in d["attenuation_at_0_1_hz"].items())}.</p>
 <ul>{notes}</ul>
 <h2>Margins per loop (each broken at its actuator, the others closed)</h2>
 <table><tr><th>loop</th><th>model</th><th>gain margin (dB)</th><th>phase margin (deg)</th><th>crossover (Hz)</th></tr>
-{''.join(rows)}</table>
+{"".join(rows)}</table>
 <h2>Figures</h2>{figs}
 <h2>Plant parameters and their sources</h2>
-<p>mass {_num(plant['mass_kg'])} kg; umbilical k {escape(str(plant['umbilical']['k_N_per_m']))} N/m,
-c {escape(str(plant['umbilical']['c_N_s_per_m']))} N s/m; rattlespace {_num(plant['rattlespace_m'])} m;
-actuator force {_num(plant['actuator_force_N'])} N; sampling {_num(plant['sample_rate_hz'])} Hz, delay {_num(plant['delay_s'])} s.</p>
+<p>mass {_num(plant["mass_kg"])} kg; umbilical k {escape(str(plant["umbilical"]["k_N_per_m"]))} N/m,
+c {escape(str(plant["umbilical"]["c_N_s_per_m"]))} N s/m; rattlespace {_num(plant["rattlespace_m"])} m;
+actuator force {_num(plant["actuator_force_N"])} N; sampling {_num(plant["sample_rate_hz"])} Hz, delay {_num(plant["delay_s"])} s.</p>
 <table><tr><th>parameter</th><th>source</th></tr>{src}</table>
 </body></html>
 """

@@ -25,8 +25,9 @@ which rolls off at 20 dB/decade between the corner ``(k + omega_p^2) / omega_a``
 :func:`design_feedback` designs to a :class:`~microg.isolation.active.target.Target`: the
 largest ``omega_a`` whose loop keeps ``PM_MIN`` of phase and ``GM_MIN`` of gain margin (the
 accelerometer filter and the delay limit it) and stays within the plant's ``max_loop_hz`` (the
-platform's own flexible modes, not modelled, bound it), then the stiffest centring ``omega_p`` that still
-meets the target with a factor ``DESIGN_MARGIN`` to spare (the least stroke for the target).
+platform's own flexible modes, not modelled, bound it), then the stiffest centring ``omega_p``
+that still meets the target with a factor ``DESIGN_MARGIN`` to spare (the least stroke for
+the target).
 Rotational channels get their own ``omega_a`` and the translational ``omega_p``.
 
 :func:`design_h2` synthesises an H2 (LQG) controller with :func:`control.h2syn` (slycot) on the
@@ -104,10 +105,16 @@ class Controller:
         """JSON-ready parameters (frequencies in Hz beside rad/s)."""
         out: dict[str, Any] = {"kind": self.kind, "n_states": int(self.system.nstates)}
         if self.omega_a is not None and self.omega_p is not None:
-            out["accel_loop_rad_per_s"] = dict(zip(DOF_NAMES, map(float, self.omega_a), strict=True))
-            out["accel_loop_hz"] = {n: float(w) / (2 * math.pi) for n, w in zip(DOF_NAMES, self.omega_a, strict=True)}
+            out["accel_loop_rad_per_s"] = dict(
+                zip(DOF_NAMES, map(float, self.omega_a), strict=True)
+            )
+            out["accel_loop_hz"] = {
+                n: float(w) / (2 * math.pi) for n, w in zip(DOF_NAMES, self.omega_a, strict=True)
+            }
             out["centring_rad_per_s"] = dict(zip(DOF_NAMES, map(float, self.omega_p), strict=True))
-            out["centring_hz"] = {n: float(w) / (2 * math.pi) for n, w in zip(DOF_NAMES, self.omega_p, strict=True)}
+            out["centring_hz"] = {
+                n: float(w) / (2 * math.pi) for n, w in zip(DOF_NAMES, self.omega_p, strict=True)
+            }
         out["notes"] = list(self.notes)
         return out
 
@@ -183,8 +190,8 @@ def channel_transmissibility(
     """Decoupled channel ``i``'s base-to-platform transmissibility, complex (module docstring).
 
     ``T = (c s + k + D w_p^2) / (s^2 + c s + k + D (g H s^2 + w_p^2))`` with ``D`` the Pade
-    delay, ``H`` the accelerometer filter, ``g = omega_a s / (s + omega_l)^2`` (derived from the channel's
-    ``q'' + c q' + k q = -a0 + v``, ``v = -D (g H a + w_p^2 q)``, ``a = q'' + a0``).
+    delay, ``H`` the accelerometer filter, ``g = omega_a s / (s + omega_l)^2`` (derived from the
+    channel's     ``q'' + c q' + k q = -a0 + v``, ``v = -D (g H a + w_p^2 q)``, ``a = q'' + a0``).
 
     Parameters
     ----------
@@ -206,7 +213,9 @@ def channel_transmissibility(
     return top / (s**2 + c * s + k + dly * (g * h * s**2 + omega_p**2))
 
 
-def _channel_loop(plant: ActivePlant, i: int, omega_a: float, omega_p: float, pade_order: int) -> Any:
+def _channel_loop(
+    plant: ActivePlant, i: int, omega_a: float, omega_p: float, pade_order: int
+) -> Any:
     """Loop of decoupled channel ``i`` broken at the actuator, ``control.StateSpace`` (SISO).
 
     ``L = D (g H s^2 + w_p^2) / (s^2 + c s + k)``; built as a series of small state-space
@@ -225,7 +234,9 @@ def _channel_loop(plant: ActivePlant, i: int, omega_a: float, omega_p: float, pa
     )  # omega_a s / (s + wl)^2
     if math.isfinite(plant.accel_bandwidth_hz):
         wb = 2 * math.pi * plant.accel_bandwidth_hz
-        h = ct.ss([[0.0, 1.0], [-(wb**2), -math.sqrt(2.0) * wb]], [[0.0], [wb**2]], [[1.0, 0.0]], [[0.0]])
+        h = ct.ss(
+            [[0.0, 1.0], [-(wb**2), -math.sqrt(2.0) * wb]], [[0.0], [wb**2]], [[1.0, 0.0]], [[0.0]]
+        )
     else:
         h = gain(np.eye(1))
     ctrl = ct.append(g * h, gain(np.array([[omega_p**2]])))
@@ -239,7 +250,9 @@ def _channel_loop(plant: ActivePlant, i: int, omega_a: float, omega_p: float, pa
 _DESIGN_OMEGA = 2 * math.pi * np.geomspace(1e-6, 2e4, 1500)
 
 
-def loop_margin_values(loop: Any, omega: np.ndarray) -> tuple[float, float, float | None, float | None]:
+def loop_margin_values(
+    loop: Any, omega: np.ndarray
+) -> tuple[float, float, float | None, float | None]:
     """(gain margin, phase margin in degrees, gain- and phase-crossover in rad/s) of a SISO loop.
 
     Read by :func:`control.stability_margins` (``returnall``) from the loop's frequency
@@ -251,7 +264,9 @@ def loop_margin_values(loop: Any, omega: np.ndarray) -> tuple[float, float, floa
     """
     import control as ct
 
-    gms, pms, _, wpcs, wgcs, _ = ct.stability_margins(ct.frd(loop, omega, smooth=True), returnall=True)
+    gms, pms, _, wpcs, wgcs, _ = ct.stability_margins(
+        ct.frd(loop, omega, smooth=True), returnall=True
+    )
     gms, pms = np.atleast_1d(np.asarray(gms, float)), np.atleast_1d(np.asarray(pms, float))
     wpcs, wgcs = np.atleast_1d(np.asarray(wpcs, float)), np.atleast_1d(np.asarray(wgcs, float))
     gm, wpc = math.inf, None
@@ -320,7 +335,11 @@ def design_feedback(plant: ActivePlant, target: Target, *, pade_order: int = 3) 
     notes.append(
         f"acceleration loops at the largest gain keeping {PM_MIN_DEG:g} deg / "
         f"{20 * math.log10(GM_MIN):.0f} dB margins"
-        + (f" (capped at max_loop_hz = {plant.max_loop_hz:g} Hz: {', '.join(capped)})" if capped else "")
+        + (
+            f" (capped at max_loop_hz = {plant.max_loop_hz:g} Hz: {', '.join(capped)})"
+            if capped
+            else ""
+        )
         + ": "
         + ", ".join(f"{n} {w / (2 * math.pi):.3g} Hz" for n, w in zip(DOF_NAMES, wa, strict=True))
     )
@@ -343,7 +362,10 @@ def design_feedback(plant: ActivePlant, target: Target, *, pade_order: int = 3) 
             )
             best = OMEGA_P_MIN
         # the centring loop must keep the margins too (halved until it does)
-        while best > OMEGA_P_MIN and not _margins_ok(_channel_loop(plant, i, wa[i], best, pade_order))[0]:
+        while (
+            best > OMEGA_P_MIN
+            and not _margins_ok(_channel_loop(plant, i, wa[i], best, pade_order))[0]
+        ):
             best = max(0.5 * best, OMEGA_P_MIN)
         wp_t[i] = best
         if pass_f is not None:
@@ -357,7 +379,9 @@ def design_feedback(plant: ActivePlant, target: Target, *, pade_order: int = 3) 
     notes.append(
         "centring at the stiffest value meeting the target with a factor "
         f"{DESIGN_MARGIN:g} to spare: "
-        + ", ".join(f"{n} {w / (2 * math.pi):.3g} Hz" for n, w in zip(DOF_NAMES[:3], wp_t, strict=True))
+        + ", ".join(
+            f"{n} {w / (2 * math.pi):.3g} Hz" for n, w in zip(DOF_NAMES[:3], wp_t, strict=True)
+        )
     )
     return Controller("designed", feedback_controller(plant, wa, wp), wa, wp, tuple(notes))
 
@@ -437,7 +461,10 @@ def design_h2(plant: ActivePlant, target: Target, *, pade_order: int = 3) -> Con
 
 
 def _exo_map(a0_w: float, na_w: float, np_w: float) -> np.ndarray:
-    """Weights of the synthesis inputs ``[a0, n_a, n_p, u]`` onto the plant's ``[a0, d, n_a, n_p, u]``."""
+    """Weights of the synthesis inputs ``[a0, n_a, n_p, u]`` on the plant's inputs.
+
+    Parameters: the base acceleration's, the accelerometers' and the position sensors' levels.
+    """
     m = np.zeros((27, 21))
     m[0:3, 0:3] = a0_w * np.eye(3)
     m[9:15, 3:9] = na_w * np.eye(6)

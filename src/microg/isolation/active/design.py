@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from microg.errors import InputError
+from microg.isolation.active import verify
 from microg.isolation.active.controller import (
     CONTROLLERS,
     Controller,
@@ -41,14 +42,13 @@ from microg.isolation.active.target import (
     band_target,
     target_by_name,
 )
-from microg.isolation.active import verify
 from microg.units import G0
 
 __all__ = ["design_active", "default_freq_hz"]
 
 
 def default_freq_hz(plant: ActivePlant, target: Target, n: int = 500) -> np.ndarray:
-    """Curves' frequencies: 1e-4 Hz to the lesser of 300 Hz and 0.45 fs, with the target's checks."""
+    """Curves' frequencies, Hz: 1e-4 Hz to min(300 Hz, 0.45 fs), with the target's checks."""
     top = min(F_TOP_HZ, 0.45 * plant.sample_rate_hz)
     f = np.geomspace(1e-4, top, n)
     chk = target.check_freq_hz()
@@ -65,12 +65,15 @@ def _target(plant: ActivePlant, target: Any, preset_target: str | None) -> Targe
     if isinstance(target, Mapping):
         att = {float(c): float(v[0] if isinstance(v, tuple) else v) for c, v in target.items()}
         edges = {
-            float(c): (float(v[1]), float(v[2])) if isinstance(v, tuple) else
-            (float(c) * 2 ** (-1 / 6), float(c) * 2 ** (1 / 6))
+            float(c): (float(v[1]), float(v[2]))
+            if isinstance(v, tuple)
+            else (float(c) * 2 ** (-1 / 6), float(c) * 2 ** (1 / 6))
             for c, v in target.items()
         }
         return band_target(att, edges)
-    raise InputError(f"unknown target {target!r}", where="target", fix="use g-limit, aris or a band map")
+    raise InputError(
+        f"unknown target {target!r}", where="target", fix="use g-limit, aris or a band map"
+    )
 
 
 #: a designed controller whose coupled (6-DOF) loop is unstable is designed again with the
@@ -90,15 +93,23 @@ def _controller(plant: ActivePlant, kind: str, target: Target, pade_order: int) 
             ceiling = float(ctrl.omega_a.min()) / (4 * math.pi)
             trial = design_feedback(plant.with_(max_loop_hz=ceiling), target, pade_order=pade_order)
             ctrl = Controller(
-                trial.kind, trial.system, trial.omega_a, trial.omega_p,
-                (*trial.notes, f"the coupled loop was unstable: loops backed off to {ceiling:.3g} Hz"),
+                trial.kind,
+                trial.system,
+                trial.omega_a,
+                trial.omega_p,
+                (
+                    *trial.notes,
+                    f"the coupled loop was unstable: loops backed off to {ceiling:.3g} Hz",
+                ),
             )
         return ctrl
     if kind == "off":
         return no_controller()
     if kind == "h2":
         return design_h2(plant, target, pade_order=pade_order)
-    raise InputError(f"unknown controller {kind!r}", where="controller", fix=f"use {', '.join(CONTROLLERS)}")
+    raise InputError(
+        f"unknown controller {kind!r}", where="controller", fix=f"use {', '.join(CONTROLLERS)}"
+    )
 
 
 def design_active(
@@ -208,8 +219,13 @@ def design_active(
         base_a = assess(t, a0, req)
         iso = assess(t, plat, req)
         spec = acceleration_psd(t, a0)
-        s_out = np.einsum("ijf,jf->if", np.abs(verify.transmissibility_matrix(cl, spec.freq_hz)) ** 2, spec.psd)
-        spectral = band_rms(Spectrum(spec.freq_hz, s_out, spec.df_hz, spec.nyquist_hz, spec.method, spec.record_s), bands)
+        s_out = np.einsum(
+            "ijf,jf->if", np.abs(verify.transmissibility_matrix(cl, spec.freq_hz)) ** 2, spec.psd
+        )
+        spectral = band_rms(
+            Spectrum(spec.freq_hz, s_out, spec.df_hz, spec.nyquist_hz, spec.method, spec.record_s),
+            bands,
+        )
         nb = iso.third_octave.center_hz.size
         noise = nb_rms[:, :nb]
         combined = np.sqrt(iso.third_octave.rms_g**2 + noise**2)
@@ -236,14 +252,14 @@ def design_active(
             j = int(np.argmax(time.peak_stroke / stroke_lim))
             notes.append(
                 f"stroke {time.peak_stroke[j]:.3g} {'m' if j < 3 else 'rad'} on "
-                f"{'x y z rx ry rz'.split()[j]} exceeds the limit {stroke_lim[j]:.3g}"
+                f"{['x', 'y', 'z', 'rx', 'ry', 'rz'][j]} exceeds the limit {stroke_lim[j]:.3g}"
             )
         if np.any(time.peak_force > force_lim):
             exceeded.append("actuator_force")
             j = int(np.argmax(time.peak_force / force_lim))
             notes.append(
                 f"actuator {'force' if j < 3 else 'torque'} {time.peak_force[j]:.3g} on "
-                f"{'x y z rx ry rz'.split()[j]} exceeds the limit {force_lim[j]:.3g}"
+                f"{['x', 'y', 'z', 'rx', 'ry', 'rz'][j]} exceeds the limit {force_lim[j]:.3g}"
             )
     if np.any(nb_rms > req.limit_g[None, :]):
         exceeded.append("sensor_noise")

@@ -96,7 +96,9 @@ def _vec3(value: Any, where: str, *, positive: bool, allow_inf: bool = False) ->
     return v
 
 
-def _scalar(value: float, where: str, *, allow_zero: bool = False, allow_inf: bool = False) -> float:
+def _scalar(
+    value: float, where: str, *, allow_zero: bool = False, allow_inf: bool = False
+) -> float:
     v = float(value)
     ok = (v >= 0 if allow_zero else v > 0) and not math.isnan(v) and (allow_inf or math.isfinite(v))
     if not ok:
@@ -139,14 +141,14 @@ class ActivePlant:
     mass_kg: float
     inertia_kg_m2: np.ndarray
     cm_offset_m: np.ndarray
-    umbilical_k_N_per_m: np.ndarray
-    umbilical_c_N_s_per_m: np.ndarray
-    umbilical_k_N_m_per_rad: np.ndarray
-    umbilical_c_N_m_s_per_rad: np.ndarray
+    umbilical_k_N_per_m: np.ndarray  # noqa: N815
+    umbilical_c_N_s_per_m: np.ndarray  # noqa: N815
+    umbilical_k_N_m_per_rad: np.ndarray  # noqa: N815
+    umbilical_c_N_m_s_per_rad: np.ndarray  # noqa: N815
     rattlespace_m: float
     rattlespace_rad: float
-    actuator_force_N: float
-    actuator_torque_N_m: float
+    actuator_force_N: float  # noqa: N815
+    actuator_torque_N_m: float  # noqa: N815
     accel_noise_ug_per_rthz: float = 0.0
     accel_bandwidth_hz: float = math.inf
     position_noise_m_per_rthz: float = 0.0
@@ -181,7 +183,10 @@ class ActivePlant:
             ("umbilical_c_N_m_s_per_rad", "umbilical-rot-damping"),
         ):
             s(self, name, _vec3(getattr(self, name), where, positive=False))
-        for name, where in (("umbilical_k_coupling", "k-coupling"), ("umbilical_c_coupling", "c-coupling")):
+        for name, where in (
+            ("umbilical_k_coupling", "k-coupling"),
+            ("umbilical_c_coupling", "c-coupling"),
+        ):
             v = getattr(self, name)
             if v is not None:
                 v = np.asarray(v, float)
@@ -196,10 +201,26 @@ class ActivePlant:
             ("sample_rate_hz", "sample-rate"),
         ):
             s(self, name, _scalar(getattr(self, name), where))
-        s(self, "accel_noise_ug_per_rthz", _scalar(self.accel_noise_ug_per_rthz, "accel-noise", allow_zero=True))
-        s(self, "position_noise_m_per_rthz", _scalar(self.position_noise_m_per_rthz, "position-noise", allow_zero=True))
-        s(self, "accel_bandwidth_hz", _scalar(self.accel_bandwidth_hz, "accel-bandwidth", allow_inf=True))
-        s(self, "position_range_m", _scalar(self.position_range_m, "position-range", allow_inf=True))
+        s(
+            self,
+            "accel_noise_ug_per_rthz",
+            _scalar(self.accel_noise_ug_per_rthz, "accel-noise", allow_zero=True),
+        )
+        s(
+            self,
+            "position_noise_m_per_rthz",
+            _scalar(self.position_noise_m_per_rthz, "position-noise", allow_zero=True),
+        )
+        s(
+            self,
+            "accel_bandwidth_hz",
+            _scalar(self.accel_bandwidth_hz, "accel-bandwidth", allow_inf=True),
+        )
+        s(
+            self,
+            "position_range_m",
+            _scalar(self.position_range_m, "position-range", allow_inf=True),
+        )
         s(self, "delay_s", _scalar(self.delay_s, "delay", allow_zero=True))
         s(self, "max_loop_hz", _scalar(self.max_loop_hz, "max-loop", allow_inf=True))
         if self.delay_s * self.sample_rate_hz > 100:

@@ -1,4 +1,4 @@
-"""The result of an active-isolation design: :class:`ActiveIsolation` (what ``microg isolate active`` prints)."""
+"""The result of an active-isolation design: :class:`ActiveIsolation`."""
 
 from __future__ import annotations
 
@@ -111,7 +111,7 @@ class TimeCheck:
 
 @dataclass(frozen=True)
 class ActiveIsolation:
-    """An actively isolated payload, designed and verified (:func:`~microg.isolation.active.design.design_active`).
+    """An actively isolated payload, designed and verified (``design_active``).
 
     Attributes
     ----------
@@ -169,7 +169,8 @@ class ActiveIsolation:
     def margins_kept(self) -> bool:
         """Every loop keeps the design minima (phase and gain margin), both models."""
         return all(
-            m.phase_margin_deg >= PM_MIN_DEG and m.gain_margin_factor >= GM_MIN for m in self.margins
+            m.phase_margin_deg >= PM_MIN_DEG and m.gain_margin_factor >= GM_MIN
+            for m in self.margins
         )
 
     def transmissibility_axis(self) -> np.ndarray:
@@ -180,12 +181,17 @@ class ActiveIsolation:
         """``1 / |T_ii|`` per axis at one frequency (log-log interpolation), (3,)."""
         t = self.transmissibility_axis()
         lf = np.log(self.freq_hz)
-        return np.array([1.0 / math.exp(np.interp(math.log(freq_hz), lf, np.log(t[i]))) for i in range(3)])
+        return np.array(
+            [1.0 / math.exp(np.interp(math.log(freq_hz), lf, np.log(t[i]))) for i in range(3)]
+        )
 
     @property
     def complies(self) -> bool:
-        """The platform meets the requirement at the mount point (time check, noise included)
-        with a stable design, margins kept, stroke and force within limits."""
+        """The platform meets the requirement at the mount point, every limit kept.
+
+        The time check (noise included) complies, the design is stable with its margins kept,
+        and the stroke and force stay within their limits.
+        """
         if self.time is None or not self.stable or not self.margins_kept:
             return False
         stroke, force = self.plant.limits()
@@ -237,7 +243,12 @@ class ActiveIsolation:
                 "limit_g": _nums(self.noise_limit_g),
                 "rms_g_axis": {a: _nums(self.noise_band_rms_g[i]) for i, a in enumerate(_AXES)},
                 "worst_margin": json_number(
-                    float(np.min(self.noise_limit_g / np.maximum(self.noise_band_rms_g.max(axis=0), 1e-300)))
+                    float(
+                        np.min(
+                            self.noise_limit_g
+                            / np.maximum(self.noise_band_rms_g.max(axis=0), 1e-300)
+                        )
+                    )
                 ),
             },
             "attenuation_at_0_1_hz": dict(
@@ -248,7 +259,9 @@ class ActiveIsolation:
             "target": {
                 **self.target.to_dict(),
                 "limit": _nums(self.target.limit(self.freq_hz)),
-                "worst_ratio_axis": dict(zip(_AXES, map(json_number, self.target_ratio), strict=True)),
+                "worst_ratio_axis": dict(
+                    zip(_AXES, map(json_number, self.target_ratio), strict=True)
+                ),
                 "passes_quasi_steady": self.passes_quasi_steady,
             },
             "meets_target": bool(self.meets_target),
@@ -267,7 +280,7 @@ class ActiveIsolation:
         return out
 
     def to_xarray(self) -> Any:
-        """Curves on ``freq_hz`` and (with a time check) histories on ``time_s``, ``xarray.Dataset``."""
+        """Curves on ``freq_hz``, histories on ``time_s`` (with a record), ``xarray.Dataset``."""
         import xarray as xr
 
         t_axis = self.transmissibility_axis()
@@ -279,9 +292,15 @@ class ActiveIsolation:
                 {"units": "1"},
             ),
             "target_limit": ("freq_hz", self.target.limit(self.freq_hz), {"units": "1"}),
-            "noise_psd_g2_per_hz": (("axis", "freq_hz"), self.noise_psd / G0**2, {"units": "g^2/Hz"}),
+            "noise_psd_g2_per_hz": (
+                ("axis", "freq_hz"),
+                self.noise_psd / G0**2,
+                {"units": "g^2/Hz"},
+            ),
             "disturbance_accel_per_N": (
-                ("axis", "freq_hz"), self.disturbance[:3], {"units": "m/s^2/N"}
+                ("axis", "freq_hz"),
+                self.disturbance[:3],
+                {"units": "m/s^2/N"},
             ),
         }
         coords: dict[str, Any] = {
@@ -294,8 +313,16 @@ class ActiveIsolation:
             coords["dof"] = list(DOF_NAMES)
             data["base_accel_g"] = (("axis", "time_s"), tm.base_accel / G0, {"units": "g"})
             data["platform_accel_g"] = (("axis", "time_s"), tm.platform_accel / G0, {"units": "g"})
-            data["stroke"] = (("dof", "time_s"), tm.stroke, {"units": "m (x, y, z); rad (rx, ry, rz)"})
-            data["force"] = (("dof", "time_s"), tm.force, {"units": "N (x, y, z); N m (rx, ry, rz)"})
+            data["stroke"] = (
+                ("dof", "time_s"),
+                tm.stroke,
+                {"units": "m (x, y, z); rad (rx, ry, rz)"},
+            )
+            data["force"] = (
+                ("dof", "time_s"),
+                tm.force,
+                {"units": "N (x, y, z); N m (rx, ry, rz)"},
+            )
         return xr.Dataset(
             data,
             coords=coords,
@@ -310,8 +337,11 @@ class ActiveIsolation:
         )
 
     def plot(self, ax: Any = None, kind: str = "transmissibility") -> Figure:
-        """A figure (``plotting.active``): ``transmissibility`` (with the target), ``noise``,
-        ``time`` (the time-domain check), ``margins`` (Nyquist of each loop) or ``bands``."""
+        """A figure of the design (``plotting.active``), on ``ax`` when given.
+
+        ``kind``: ``transmissibility`` (with the target), ``noise``, ``time`` (the time-domain
+        check), ``margins`` (Nyquist of each loop) or ``bands``.
+        """
         from microg.plotting.active import plot_active
 
         return plot_active(self, kind=kind, ax=ax)

@@ -90,9 +90,15 @@ class Target:
             "name": self.name,
             "source": self.source,
             "segments": [
-                {"lo_hz": float(lo), "hi_hz": float(hi), "max_transmissibility": float(lev),
-                 "log_slope": float(sl)}
-                for lo, hi, lev, sl in zip(self.lo_hz, self.hi_hz, self.level, self.slope, strict=True)
+                {
+                    "lo_hz": float(lo),
+                    "hi_hz": float(hi),
+                    "max_transmissibility": float(lev),
+                    "log_slope": float(sl),
+                }
+                for lo, hi, lev, sl in zip(
+                    self.lo_hz, self.hi_hz, self.level, self.slope, strict=True
+                )
             ],
             "pass_below_hz": self.pass_below_hz,
             "pass_level": PASS_LEVEL if self.pass_below_hz is not None else None,
