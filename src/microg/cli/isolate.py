@@ -301,3 +301,13 @@ def figure8(out: str, r2_max: float) -> None:
     except OSError as exc:
         raise InputError(f"cannot write {out}: {exc.strerror or exc}", where="--out") from None
     click.echo(f"wrote {out}")
+
+
+def _register_active() -> None:
+    """``microg isolate active`` lives in its own module (:mod:`microg.cli.isolate_active`)."""
+    from microg.cli.isolate_active import active
+
+    isolate.add_command(active)
+
+
+_register_active()

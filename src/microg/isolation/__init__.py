@@ -4,6 +4,7 @@ Modules: :mod:`~microg.isolation.transmissibility` (kernels of Eqs. 4.3-4.7),
 :mod:`~microg.isolation.absorber` (Den Hartog / H2 / numerical tuning),
 :mod:`~microg.isolation.design` (physical-unit mount design, Section 4.2 claims),
 :mod:`~microg.isolation.timedomain` (exact response to a sampled mount acceleration),
+:mod:`~microg.isolation.active` (active isolation: platform, controllers, verification),
 :mod:`~microg.plotting.isolation` (Figure 8).
 """
 
@@ -16,6 +17,9 @@ from typing import Any
 #: scipy.optimize and scipy.integrate, which the main job does not always need)
 _LAZY: dict[str, str] = {
     "AbsorberTuning": "microg.isolation.absorber",
+    "ActiveIsolation": "microg.isolation.active.result",
+    "ActivePlant": "microg.isolation.active.plant",
+    "design_active": "microg.isolation.active.design",
     "ClaimCheck": "microg.isolation.design",
     "IsolationTimeResponse": "microg.isolation.timedomain",
     "IsolatorModel": "microg.isolation.timedomain",
@@ -42,6 +46,8 @@ _LAZY: dict[str, str] = {
 
 __all__ = [
     "AbsorberTuning",
+    "ActiveIsolation",
+    "ActivePlant",
     "ClaimCheck",
     "IsolationTimeResponse",
     "IsolatorModel",
@@ -54,6 +60,7 @@ __all__ = [
     "check_section42_claims",
     "den_hartog",
     "den_hartog_peak_bound",
+    "design_active",
     "design_mount",
     "h2_closed_form",
     "h2_integral",

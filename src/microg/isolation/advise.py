@@ -18,6 +18,12 @@ The policy, in order:
    passive mount in the screen complies (``"no-passive-mount"``): the advice says so, gives
    the attenuation needed per band, and that active isolation is needed.  A design that
    fails its own check is never recommended.
+5. When no passive mount is recommended, the default active isolator (the ``aris`` preset,
+   :func:`~microg.isolation.active.design.design_active`) is designed for the attenuation
+   asked per band and verified on the same response: stable, margins kept, the platform's
+   band verdict (sensor noise included) compliant, stroke and force within their limits.  Only
+   then is the status ``"active-recommended"``; otherwise it stays ``"no-passive-mount"`` (or
+   ``"no-design"``) and the note says which limit binds.
 """
 
 from __future__ import annotations
@@ -36,6 +42,7 @@ if TYPE_CHECKING:
     from microg.dynamics.response import PointResponse
     from microg.environment.metrics import Assessment
     from microg.environment.requirements import Requirement
+    from microg.isolation.active.result import ActiveIsolation
     from microg.isolation.design import MountDesign
     from microg.isolation.mount import MountChoice
 
@@ -49,7 +56,11 @@ STATUSES = (
     "passive-mount",
     "no-passive-mount",
     "no-design",
+    "active-recommended",
 )
+
+#: the active isolator the advice designs when no passive mount is recommended
+ACTIVE_PRESET = "aris"
 
 
 @dataclass(frozen=True)
@@ -84,7 +95,11 @@ class IsolationAdvice:
         The verified mount's natural frequency lies in the bands the record resolves, so the
         time-domain check can see its resonance.
     recommended : bool
-        True only when the verified mount complies in the time domain and is verifiable.
+        True only when the verified (passive) mount complies in the time domain and is
+        verifiable.
+    active : ActiveIsolation or None
+        The default active isolator designed and verified when no passive mount is
+        recommended (None otherwise, or when its design was refused: see the note).
     note : str
         One-paragraph summary of the above.
     """
@@ -102,6 +117,7 @@ class IsolationAdvice:
     peak_stroke_m: float | None = None
     verifiable: bool = False
     recommended: bool = False
+    active: ActiveIsolation | None = None
     note: str = ""
 
     @property
@@ -181,6 +197,8 @@ class IsolationAdvice:
             "screened_mount": None,
             "isolated": None,
         }
+        if self.active is not None:
+            out["active"] = _active_dict(self.active)
         d = self.design
         if d is not None:
             out["design"] = {
@@ -216,6 +234,91 @@ class IsolationAdvice:
                 else {"center_hz": wb.center_hz, "margin": _finite(wb.margin)},
             }
         return out
+
+
+def _active_dict(act: ActiveIsolation) -> dict[str, Any]:
+    """The ``isolation.active`` block: the verdict, margins, stroke and force of the check."""
+    full = act.to_dict()
+    cont = [m for m in act.margins if m.model == "continuous"]
+    disc = [m for m in act.margins if m.model == "discrete"]
+
+    def least(ms: list[Any]) -> dict[str, Any]:
+        if not ms:
+            return {"phase_margin_deg": None, "gain_margin_db": None}
+        pm = min(m.phase_margin_deg for m in ms)
+        gm = min(m.gain_margin_factor for m in ms)
+        return {"phase_margin_deg": _finite(pm), "gain_margin_db": _finite(20 * np.log10(gm))}
+
+    tc = full["time_check"] or {}
+    return {
+        "complies": bool(act.complies),
+        "preset": act.plant.name,
+        "controller": act.controller.kind,
+        "target": act.target.name,
+        "stable": bool(act.stable),
+        "margins_kept": bool(act.margins_kept),
+        "least_margins": {"continuous": least(cont), "discrete": least(disc)},
+        "margins": full["margins"],
+        "meets_target": bool(act.meets_target),
+        "binding_limit": act.binding_limit,
+        "limits_exceeded": list(act.limits_exceeded),
+        "stroke_m": full["stroke_m"],
+        "stroke_limit_m": full["stroke_limit_m"],
+        "force_N": full["force_N"],
+        "force_limit_N": full["force_limit_N"],
+        "attenuation_at_0_1_hz": full["attenuation_at_0_1_hz"],
+        "worst_band": tc.get("worst_band"),
+        "notes": list(act.notes),
+    }
+
+
+def _active_check(
+    point: str,
+    response: PointResponse,
+    requirement: Requirement,
+    need: dict[float, float],
+    edges: dict[float, tuple[float, float]],
+) -> tuple[ActiveIsolation | None, str]:
+    """The default active isolator for ``need``, verified on ``response``: (result, sentence)."""
+    from microg.isolation.active.design import design_active
+
+    target = {c: (need[c], *edges[c]) for c in need}
+    try:
+        act = design_active(
+            ACTIVE_PRESET,
+            target=target,
+            timepts=response.timepts,
+            base_accel=response.acceleration,
+            point=point,
+            requirement=requirement,
+        )
+    except InputError as exc:
+        return None, f"the {ACTIVE_PRESET.upper()}-class active isolator could not be designed ({exc})"  # noqa: E501
+    tm = act.time
+    stroke = float(tm.peak_stroke[:3].max()) if tm is not None else float("nan")
+    force = float(tm.peak_force[:3].max()) if tm is not None else float("nan")
+    cont = [m for m in act.margins if m.model == "continuous"]
+    pm = min((m.phase_margin_deg for m in cont), default=float("inf"))
+    gm = min((m.gain_margin_factor for m in cont), default=float("inf"))
+    facts = (
+        f"stroke {stroke:.3g} m of {act.plant.limits()[0][0]:.3g} m, force {force:.3g} N of "
+        f"{act.plant.limits()[1][0]:.3g} N, phase margin {pm:.3g} deg, gain margin "
+        f"{20 * np.log10(gm):.3g} dB"
+    )
+    if act.complies:
+        return act, (
+            f"Active isolation recommended: the {ACTIVE_PRESET.upper()}-class isolator "
+            f"(acceleration feedback with centring, designed for the attenuation per band) "
+            f"complies in the time domain with the sensor noise included ({facts})"
+        )
+    why = act.binding_limit or (
+        "stability" if not act.stable else "the loop margins" if not act.margins_kept
+        else "the platform's band verdict"
+    )
+    return act, (
+        f"the {ACTIVE_PRESET.upper()}-class active isolator designed for it does not comply "
+        f"either ({why} binds; {facts}): not recommended"
+    )
 
 
 def _finite(x: float) -> float | str:
@@ -266,6 +369,10 @@ def advise_isolation(
             "without knowing its spectrum",
         )
     need = {float(c): float(1.0 / mm) for c, mm in zip(to.center_hz[bad], margin[bad], strict=True)}
+    edges = {
+        float(c): (float(a), float(b))
+        for c, a, b in zip(to.center_hz[bad], to.lower_hz[bad], to.upper_hz[bad], strict=True)
+    }
     lo = float(to.lower_hz[bad].min())
     hi = float(to.upper_hz[bad].max())
     target = float(max(margin[bad].min(), 1e-6))
@@ -279,13 +386,16 @@ def advise_isolation(
             package_mass, (2 * np.pi * lo, 2 * np.pi * hi), min(target, 1.0), mu=absorber_mu
         )
     except InputError as exc:
+        act, sentence = _active_check(point, response, requirement, need, edges)
+        ok_act = act is not None and act.complies
         return IsolationAdvice(
             point,
-            "no-design",
+            "active-recommended" if ok_act else "no-design",
             attenuation_needed=need,
             band_hz=(lo, hi),
             target_ma=target,
-            note=f"{base}; the report's rule gives no design ({exc}); active isolation is needed",
+            active=act,
+            note=f"{base}; the report's rule gives no passive design ({exc}); {sentence}",
         )
     # a mount resonating below the record's resolved bands cannot be verified by this record:
     # screen only mounts whose natural frequency the verdict can see
@@ -355,6 +465,12 @@ def advise_isolation(
             "recommended: active isolation (ARIS-class) is needed for the attenuation listed "
             "per band"
         )
+    act = None
+    if status == "no-passive-mount":
+        act, sentence = _active_check(point, response, requirement, need, edges)
+        if act is not None and act.complies:
+            status = "active-recommended"
+        note = f"{note}; {sentence}"
     return IsolationAdvice(
         point=point,
         status=status,
@@ -369,5 +485,6 @@ def advise_isolation(
         peak_stroke_m=stroke,
         verifiable=visible,
         recommended=ok,
+        active=act,
         note=note,
     )

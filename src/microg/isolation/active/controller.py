@@ -1,0 +1,473 @@
+"""Controllers of an active isolator: acceleration feedback with relative-position centring, H2.
+
+The ARIS / g-LIMIT architecture (Fialho & Thampi, AIAA 2000; Whorton, NASA MSFC): the measured
+platform acceleration is fed back through an integrator (absolute-velocity, "sky-hook",
+feedback) and the measured relative position through a centring spring, decoupled by the
+platform's mass matrix:
+
+    u = -M (g(s) a_m  +  diag(omega_p^2)  q_m),   g_i(s) = omega_a,i s / (s + omega_l,i)^2,
+
+an integrator (``omega_a / s`` above ``omega_l``) behind a second-order high-pass at
+``omega_l = LEAK_RATIO * (k + omega_p^2) / omega_a`` a decade below the isolation corner: the
+loop takes no static force, so a constant (quasi-steady) acceleration is passed with the
+centring spring's stroke ``a0 / (k + omega_p^2)`` only (a pure integrator would integrate it
+into an ever-growing force), at the price of a mild peak (about 1.16) below the corner.
+
+Per decoupled channel (``k = (M^-1 K)_ii``, ``c = (M^-1 C)_ii``), with ideal sensors and no
+delay, the base-to-platform transmissibility is the closed form
+
+    T(s) = (c s + k + omega_p^2) / (s^2 (1 + g(s)) + c s + k + omega_p^2),
+
+which rolls off at 20 dB/decade between the corner ``(k + omega_p^2) / omega_a`` and
+``omega_a``, at 40 dB/decade above, down to the umbilical damping's floor ``c / omega``
+(:func:`channel_transmissibility` evaluates it with the sensor filter and the delay).
+
+:func:`design_feedback` designs to a :class:`~microg.isolation.active.target.Target`: the
+largest ``omega_a`` whose loop keeps ``PM_MIN`` of phase and ``GM_MIN`` of gain margin (the
+accelerometer filter and the delay limit it) and stays within the plant's ``max_loop_hz`` (the
+platform's own flexible modes, not modelled, bound it), then the stiffest centring ``omega_p``
+that still meets the target with a factor ``DESIGN_MARGIN`` to spare (the least stroke for
+the target).
+Rotational channels get their own ``omega_a`` and the translational ``omega_p``.
+
+:func:`design_h2` synthesises an H2 (LQG) controller with :func:`control.h2syn` (slycot) on the
+generalized plant, weighting the platform acceleration over the target's band, the stroke by
+the rattlespace and the force by the actuator limit (Bryson's rule).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from microg.errors import InputError
+from microg.isolation.active.plant import DOF_NAMES, ActivePlant, gain
+
+if TYPE_CHECKING:
+    from microg.isolation.active.target import Target
+
+__all__ = [
+    "Controller",
+    "CONTROLLERS",
+    "feedback_controller",
+    "channel_transmissibility",
+    "design_feedback",
+    "design_h2",
+    "loop_margin_values",
+    "no_controller",
+    "PM_MIN_DEG",
+    "GM_MIN",
+    "DESIGN_MARGIN",
+]
+
+#: controller kinds
+CONTROLLERS = ("designed", "h2", "off")
+#: least phase margin of every loop of a designed controller, degrees
+PM_MIN_DEG = 45.0
+#: least gain margin of every loop of a designed controller (6 dB)
+GM_MIN = 2.0
+#: a designed controller meets its target with this factor to spare (the MIMO model adds the
+#: coupling and the exact sensor/delay dynamics the channel design approximates)
+DESIGN_MARGIN = 0.8
+#: the acceleration loop's high-pass sits this fraction of the isolation corner
+LEAK_RATIO = 0.1
+#: H2 synthesis: least accelerometer noise relative to the base level, and least position
+#: noise (m/sqrt(Hz)) (conditioning of the filter Riccati equation)
+SYNTH_NOISE_RATIO = 0.03
+SYNTH_POSITION_NOISE_M = 1e-4
+#: least centring, rad/s (keeps a platform without umbilical stiffness centred)
+OMEGA_P_MIN = 2 * math.pi * 1e-4
+
+
+@dataclass(frozen=True)
+class Controller:
+    """A controller of the generalized plant: ``u = K y``, ``y = [a_m (6), q_m (6)]``.
+
+    Attributes
+    ----------
+    kind : ``designed``, ``h2`` or ``off``
+    system : ``control.StateSpace`` (12 inputs, 6 outputs), continuous
+    omega_a : (6,) acceleration-loop gain per channel, rad/s (None for ``h2``)
+    omega_p : (6,) centring frequency per channel, rad/s (None for ``h2``)
+    notes : what the design found (which limit set each parameter)
+    """
+
+    kind: str
+    system: Any = field(repr=False)
+    omega_a: np.ndarray | None = None
+    omega_p: np.ndarray | None = None
+    notes: tuple[str, ...] = ()
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready parameters (frequencies in Hz beside rad/s)."""
+        out: dict[str, Any] = {"kind": self.kind, "n_states": int(self.system.nstates)}
+        if self.omega_a is not None and self.omega_p is not None:
+            out["accel_loop_rad_per_s"] = dict(
+                zip(DOF_NAMES, map(float, self.omega_a), strict=True)
+            )
+            out["accel_loop_hz"] = {
+                n: float(w) / (2 * math.pi) for n, w in zip(DOF_NAMES, self.omega_a, strict=True)
+            }
+            out["centring_rad_per_s"] = dict(zip(DOF_NAMES, map(float, self.omega_p), strict=True))
+            out["centring_hz"] = {
+                n: float(w) / (2 * math.pi) for n, w in zip(DOF_NAMES, self.omega_p, strict=True)
+            }
+        out["notes"] = list(self.notes)
+        return out
+
+
+def leak(plant: ActivePlant, i: int, omega_a: float, omega_p: float) -> float:
+    """High-pass corner ``omega_l`` of channel ``i``'s acceleration loop, rad/s (docstring)."""
+    k, _ = plant.channel(i)
+    return LEAK_RATIO * (max(k, 0.0) + omega_p**2) / omega_a
+
+
+def feedback_controller(plant: ActivePlant, omega_a: np.ndarray, omega_p: np.ndarray) -> Any:
+    """``u = -M (g(s) a_m + diag(omega_p^2) q_m)``, ``control.StateSpace`` (module docstring).
+
+    Parameters
+    ----------
+    plant : the plant (its mass matrix decouples the loops)
+    omega_a : (6,) acceleration-loop gains, rad/s
+    omega_p : (6,) centring frequencies, rad/s
+    """
+    import control as ct
+
+    mm = plant.mass_matrix()
+    wa = np.asarray(omega_a, float)
+    wp = np.asarray(omega_p, float)
+    wl = np.array([leak(plant, i, wa[i], wp[i]) for i in range(6)])
+    # per channel g = wa s / (s + wl)^2: states (x1, x2) with x1' = -wl x1 + a, x2' = x1 - wl x2,
+    # g a = wa (x1 - wl x2)  (x1 = a / (s + wl), x2 = a / (s + wl)^2)
+    a = np.zeros((12, 12))
+    b = np.zeros((12, 12))
+    c = np.zeros((6, 12))
+    for i in range(6):
+        a[2 * i, 2 * i] = -wl[i]
+        a[2 * i + 1, 2 * i] = 1.0
+        a[2 * i + 1, 2 * i + 1] = -wl[i]
+        b[2 * i, i] = 1.0
+        c[i, 2 * i] = wa[i]
+        c[i, 2 * i + 1] = -wa[i] * wl[i]
+    d = np.hstack([np.zeros((6, 6)), -mm @ np.diag(wp**2)])
+    return ct.ss(a, b, -mm @ c, d)
+
+
+def no_controller() -> Controller:
+    """The controller off: ``u = 0`` (the platform rides on its umbilicals)."""
+    return Controller("off", gain(np.zeros((6, 12))), None, None, ("controller off",))
+
+
+def _pade_poly(plant: ActivePlant, order: int) -> tuple[np.ndarray, np.ndarray]:
+    import control as ct
+
+    tau = plant.effective_delay_s
+    if tau <= 0 or order == 0:
+        return np.array([1.0]), np.array([1.0])
+    num, den = ct.pade(tau, order)
+    return np.asarray(num, float), np.asarray(den, float)
+
+
+def _accel_filter(plant: ActivePlant, s: np.ndarray) -> np.ndarray:
+    if not math.isfinite(plant.accel_bandwidth_hz):
+        return np.ones_like(s)
+    wb = 2 * math.pi * plant.accel_bandwidth_hz
+    return wb**2 / (s**2 + math.sqrt(2.0) * wb * s + wb**2)
+
+
+def channel_transmissibility(
+    plant: ActivePlant,
+    i: int,
+    omega_a: float,
+    omega_p: float,
+    freq_hz: np.ndarray,
+    *,
+    pade_order: int = 3,
+) -> np.ndarray:
+    """Decoupled channel ``i``'s base-to-platform transmissibility, complex (module docstring).
+
+    ``T = (c s + k + D w_p^2) / (s^2 + c s + k + D (g H s^2 + w_p^2))`` with ``D`` the Pade
+    delay, ``H`` the accelerometer filter, ``g = omega_a s / (s + omega_l)^2`` (derived from the
+    channel's     ``q'' + c q' + k q = -a0 + v``, ``v = -D (g H a + w_p^2 q)``, ``a = q'' + a0``).
+
+    Parameters
+    ----------
+    plant : the plant
+    i : channel (0-5: x, y, z, rx, ry, rz)
+    omega_a : acceleration-loop gain, rad/s
+    omega_p : centring frequency, rad/s
+    freq_hz : frequencies, Hz
+    pade_order : order of the delay's Pade approximant
+    """
+    k, c = plant.channel(i)
+    s = 2j * math.pi * np.asarray(freq_hz, float)
+    num, den = _pade_poly(plant, pade_order)
+    dly = np.polyval(num, s) / np.polyval(den, s)
+    wl = leak(plant, i, omega_a, omega_p)
+    g = omega_a * s / (s + wl) ** 2
+    h = _accel_filter(plant, s)
+    top = c * s + k + dly * omega_p**2
+    return top / (s**2 + c * s + k + dly * (g * h * s**2 + omega_p**2))
+
+
+def _channel_loop(
+    plant: ActivePlant, i: int, omega_a: float, omega_p: float, pade_order: int
+) -> Any:
+    """Loop of decoupled channel ``i`` broken at the actuator, ``control.StateSpace`` (SISO).
+
+    ``L = D (g H s^2 + w_p^2) / (s^2 + c s + k)``; built as a series of small state-space
+    blocks (no high-order polynomial is ever formed).
+    """
+    import control as ct
+
+    k, c = plant.channel(i)
+    wl = leak(plant, i, omega_a, omega_p)
+    body = ct.ss([[0.0, 1.0], [-k, -c]], [[0.0], [1.0]], np.eye(2), np.zeros((2, 1)))
+    # [q, q'] -> a = q'' = v - c q' - k q enters with the feedthrough of v: use
+    # g H s^2 q = g H (v - c q' - k q); the loop's output is D (g H a + w_p^2 q)
+    acc_out = ct.ss(body.A, body.B, np.array([[-k, -c], [1.0, 0.0]]), np.array([[1.0], [0.0]]))
+    g = ct.ss(
+        [[-wl, 0.0], [1.0, -wl]], [[1.0], [0.0]], [[omega_a, -omega_a * wl]], [[0.0]]
+    )  # omega_a s / (s + wl)^2
+    if math.isfinite(plant.accel_bandwidth_hz):
+        wb = 2 * math.pi * plant.accel_bandwidth_hz
+        h = ct.ss(
+            [[0.0, 1.0], [-(wb**2), -math.sqrt(2.0) * wb]], [[0.0], [wb**2]], [[1.0, 0.0]], [[0.0]]
+        )
+    else:
+        h = gain(np.eye(1))
+    ctrl = ct.append(g * h, gain(np.array([[omega_p**2]])))
+    summed = gain(np.ones((1, 2))) * ctrl * acc_out  # v -> g H a + w_p^2 q
+    dly = plant.actuator_delay(pade_order)
+    dly1 = gain(np.eye(1, 6)) * dly * gain(np.eye(6, 1))
+    return dly1 * summed
+
+
+#: frequencies of the channel loops' margins, rad/s (read by control.stability_margins)
+_DESIGN_OMEGA = 2 * math.pi * np.geomspace(1e-6, 2e4, 1500)
+
+
+def loop_margin_values(
+    loop: Any, omega: np.ndarray
+) -> tuple[float, float, float | None, float | None]:
+    """(gain margin, phase margin in degrees, gain- and phase-crossover in rad/s) of a SISO loop.
+
+    Read by :func:`control.stability_margins` (``returnall``) from the loop's frequency
+    response at ``omega`` (rad/s), interpolated.  A loop may cross |L| = 1 and -180 deg more
+    than once: the phase margin is the least angular distance from -180 deg over the gain
+    crossovers (a phase of -258 deg is 78 deg from it), the gain margin the crossing factor
+    nearest to 1 on a log scale (a factor below 1 means that *reducing* the gain by it
+    destabilises: a conditionally stable loop); inf where there is no crossover.
+    """
+    import control as ct
+
+    gms, pms, _, wpcs, wgcs, _ = ct.stability_margins(
+        ct.frd(loop, omega, smooth=True), returnall=True
+    )
+    gms, pms = np.atleast_1d(np.asarray(gms, float)), np.atleast_1d(np.asarray(pms, float))
+    wpcs, wgcs = np.atleast_1d(np.asarray(wpcs, float)), np.atleast_1d(np.asarray(wgcs, float))
+    gm, wpc = math.inf, None
+    ok = np.isfinite(gms) & (gms > 0)
+    if ok.any():
+        j = int(np.argmin(np.abs(np.log(gms[ok]))))
+        gm, wpc = float(gms[ok][j]), float(wpcs[ok][j])
+    pm, wgc = math.inf, None
+    okp = np.isfinite(pms)
+    if okp.any():
+        dist = np.abs((pms[okp] + 180.0) % 360.0 - 180.0)
+        j = int(np.argmin(dist))
+        pm, wgc = float(dist[j]), float(wgcs[okp][j])
+    return gm, pm, wgc, wpc
+
+
+def _margins_ok(loop: Any) -> tuple[bool, float, float]:
+    import control as ct
+
+    closed = ct.feedback(loop, gain(np.eye(1)))
+    if closed.nstates and np.max(np.linalg.eigvals(closed.A).real) >= 0:
+        return False, 0.0, 0.0
+    gm, pm, _, _ = loop_margin_values(loop, _DESIGN_OMEGA)
+    return abs(math.log(gm)) >= math.log(GM_MIN) and pm >= PM_MIN_DEG, gm, pm
+
+
+def _largest(ok: Any, lo: float, hi: float, rel: float = 0.01) -> float | None:
+    """Largest x in [lo, hi] with ok(x) (ok assumed monotone: true below, false above)."""
+    if ok(hi):
+        return hi
+    if not ok(lo):
+        return None
+    while hi / lo > 1 + rel:
+        mid = math.sqrt(lo * hi)
+        lo, hi = (mid, hi) if ok(mid) else (lo, mid)
+    return lo
+
+
+def design_feedback(plant: ActivePlant, target: Target, *, pade_order: int = 3) -> Controller:
+    """Acceleration feedback with centring designed to ``target`` (module docstring).
+
+    Parameters
+    ----------
+    plant : the plant
+    target : the transmissibility target (translational channels)
+    pade_order : order of the delay's Pade approximant in the design model
+    """
+    notes: list[str] = []
+    top = 2 * math.pi * min(0.5 * plant.sample_rate_hz, plant.max_loop_hz)
+    wa = np.zeros(6)
+    for i in range(6):
+        best = _largest(
+            lambda w, i=i: _margins_ok(_channel_loop(plant, i, w, OMEGA_P_MIN, pade_order))[0],
+            2 * math.pi * 1e-3,
+            top,
+        )
+        if best is None:
+            raise InputError(
+                f"no acceleration loop on channel {DOF_NAMES[i]} keeps {PM_MIN_DEG:g} deg of "
+                f"phase and {20 * math.log10(GM_MIN):.0f} dB of gain margin",
+                where="sample-rate",
+                fix="raise the sampling rate or the accelerometer bandwidth, or shorten the delay",
+            )
+        wa[i] = best
+    capped = [n for n, w in zip(DOF_NAMES, wa, strict=True) if w >= top * (1 - 1e-9)]
+    notes.append(
+        f"acceleration loops at the largest gain keeping {PM_MIN_DEG:g} deg / "
+        f"{20 * math.log10(GM_MIN):.0f} dB margins"
+        + (
+            f" (capped at max_loop_hz = {plant.max_loop_hz:g} Hz: {', '.join(capped)})"
+            if capped
+            else ""
+        )
+        + ": "
+        + ", ".join(f"{n} {w / (2 * math.pi):.3g} Hz" for n, w in zip(DOF_NAMES, wa, strict=True))
+    )
+    f = target.check_freq_hz()
+    lim = target.limit(f)
+    pass_f = None if target.pass_below_hz is None else 0.1 * target.pass_below_hz
+    from microg.isolation.active.target import PASS_LEVEL
+
+    def meets(i: int, wp: float) -> bool:
+        t = np.abs(channel_transmissibility(plant, i, wa[i], wp, f, pade_order=pade_order))
+        return bool(np.all(t <= DESIGN_MARGIN * lim))
+
+    wp_t = np.zeros(3)
+    for i in range(3):
+        best = _largest(lambda w, i=i: meets(i, w), OMEGA_P_MIN, wa[i] / 3.0)
+        if best is None:
+            notes.append(
+                f"channel {DOF_NAMES[i]}: the target is out of reach even with the least "
+                f"centring ({OMEGA_P_MIN / (2 * math.pi):.2g} Hz): the umbilical's path binds"
+            )
+            best = OMEGA_P_MIN
+        # the centring loop must keep the margins too (halved until it does)
+        while (
+            best > OMEGA_P_MIN
+            and not _margins_ok(_channel_loop(plant, i, wa[i], best, pade_order))[0]
+        ):
+            best = max(0.5 * best, OMEGA_P_MIN)
+        wp_t[i] = best
+        if pass_f is not None:
+            tq = abs(channel_transmissibility(plant, i, wa[i], best, np.array([pass_f]))[0])
+            if tq < PASS_LEVEL:
+                notes.append(
+                    f"channel {DOF_NAMES[i]}: |T| = {tq:.3g} at {pass_f:g} Hz: the quasi-steady "
+                    "acceleration is not passed"
+                )
+    wp = np.concatenate([wp_t, np.full(3, float(wp_t.min()))])
+    notes.append(
+        "centring at the stiffest value meeting the target with a factor "
+        f"{DESIGN_MARGIN:g} to spare: "
+        + ", ".join(
+            f"{n} {w / (2 * math.pi):.3g} Hz" for n, w in zip(DOF_NAMES[:3], wp_t, strict=True)
+        )
+    )
+    return Controller("designed", feedback_controller(plant, wa, wp), wa, wp, tuple(notes))
+
+
+def design_h2(plant: ActivePlant, target: Target, *, pade_order: int = 3) -> Controller:
+    """H2 (LQG) controller by :func:`control.h2syn` (needs slycot), Bryson-weighted.
+
+    Performance outputs: the platform's linear acceleration through a band-pass over the
+    target's span (weight 1 / 1e-6 g), the relative translation over the rattlespace and the
+    actuator force over its limit; exogenous inputs: the base acceleration (1e-4 g, white), the
+    sensors' noises at their PSDs (with floors, :data:`SYNTH_NOISE_RATIO`), and a direct
+    measurement noise (the synthesis needs a
+    full-rank ``D21``).  The plant's accelerometer bandwidth must be finite (``D22 = 0``).
+
+    Parameters
+    ----------
+    plant : the plant
+    target : the target (its span sets the band-pass)
+    pade_order : order of the delay's Pade approximant
+    """
+    import control as ct
+
+    try:
+        import slycot  # noqa: F401
+    except ImportError:
+        raise InputError(
+            "the H2 design needs slycot (pip install 'microg[h2]')",
+            where="controller",
+            fix="install slycot, or use --controller designed",
+        ) from None
+    if not math.isfinite(plant.accel_bandwidth_hz):
+        raise InputError(
+            "the H2 design needs a finite accelerometer bandwidth", where="accel-bandwidth"
+        )
+    from microg.units import G0
+
+    gen = plant.generalized(pade_order)  # [a0, d, n_a, n_p, u] -> [a, q, f, a_m, q_m]
+    f_lo, f_hi = target.span_hz()
+    wl, wh = 2 * math.pi * max(f_lo, 1e-4), 2 * math.pi * min(f_hi, 0.2 * plant.sample_rate_hz)
+    bp = ct.ss(ct.tf([wh, 0.0], [1.0, wl + wh, wl * wh]))  # unit gain between wl and wh
+    stroke, force = plant.limits()
+    w_a = ct.append(*([bp * (1.0 / (1e-6 * G0))] * 3))
+    w_q, w_f = np.diag(1.0 / stroke), np.diag(1.0 / force)
+    # z = [W_a a_lin, q / stroke, f / force]; w = [a0 (3), n_a (6), n_p (6), n_y (6)]
+    sel_z = np.zeros((15, 30))
+    sel_z[0:3, 0:3] = np.eye(3)
+    sel_z[3:9, 6:12] = w_q
+    sel_z[9:15, 12:18] = w_f
+    zsys = ct.append(w_a, gain(np.eye(12))) * gain(sel_z)  # 30 outputs -> 15
+    ysel = np.hstack([np.zeros((12, 18)), np.eye(12)])
+    outs = ct.append(zsys, gain(np.eye(12))) * gain(np.vstack([np.eye(30), ysel]))
+    a0_w = 1e-4 * G0
+    # the synthesis' noise intensities have floors (the filter Riccati equation is not solved
+    # for sensor noise 1e-3 of the base level); the verification uses the plant's real noise
+    na_w = max(math.sqrt(plant.accel_noise_psd), SYNTH_NOISE_RATIO * a0_w)
+    np_w = max(math.sqrt(plant.position_noise_psd), SYNTH_POSITION_NOISE_M)
+    # synthesis inputs [a0, n_a, n_p, u] (d is left out: it feeds the acceleration directly)
+    gen_w = gen * gain(_exo_map(a0_w, na_w, np_w))
+    full = outs * gen_w
+    direct = np.zeros((full.noutputs, 6))
+    direct[15:21, :] = na_w * np.eye(6)
+    p = ct.ss(
+        full.A,
+        np.hstack([full.B[:, :15], np.zeros((full.nstates, 6)), full.B[:, 15:]]),
+        full.C,
+        np.hstack([full.D[:, :15], direct, full.D[:, 15:]]),
+    )
+    try:
+        k = ct.h2syn(p, 12, 6)
+    except Exception as exc:  # slycot reports a failed Riccati solution as a ValueError
+        raise InputError(
+            f"the H2 synthesis failed ({type(exc).__name__}: {exc})",
+            where="controller",
+            fix="use --controller designed",
+        ) from None
+    return Controller("h2", k, None, None, (f"H2 synthesis (control.h2syn): {k.nstates} states",))
+
+
+def _exo_map(a0_w: float, na_w: float, np_w: float) -> np.ndarray:
+    """Weights of the synthesis inputs ``[a0, n_a, n_p, u]`` on the plant's inputs.
+
+    Parameters: the base acceleration's, the accelerometers' and the position sensors' levels.
+    """
+    m = np.zeros((27, 21))
+    m[0:3, 0:3] = a0_w * np.eye(3)
+    m[9:15, 3:9] = na_w * np.eye(6)
+    m[15:21, 9:15] = np_w * np.eye(6)
+    m[21:27, 15:21] = np.eye(6)
+    return m

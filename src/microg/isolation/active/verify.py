@@ -1,0 +1,292 @@
+"""Verification of an active isolator: stability, margins, transmissibility, noise, time response.
+
+Everything is computed with python-control on the closed loop of the generalized plant
+(:meth:`~microg.isolation.active.plant.ActivePlant.generalized`) and the controller,
+``control.StateSpace.lft`` (``u = K y``):
+
+* **stability**: the poles of the continuous closed loop (delay as a Pade approximant) and of
+  the sampled one (ZOH plant at the sampling rate, the controller by Tustin's rule, the delay in
+  whole samples), all in the open left half-plane / the unit disc;
+* **margins per loop**: each of the six actuator channels broken with the other five closed
+  (loop-at-a-time), ``L_i = -[(I - H E_i)^-1 H]_ii`` with ``H = K P_yu``, through
+  :func:`control.stability_margins`, for both models;
+* **transmissibility**: base acceleration (x, y, z) to platform acceleration, complex (3, 3, nf);
+  the **direct-disturbance** response, force on the platform to its acceleration, beside the
+  controller-off one;
+* **noise floor**: the platform acceleration PSD that the sensors' noises put there,
+  ``S_a(f) = sum_j |H_aj(f)|^2 S_j``, and its band RMS over a requirement's bands (Gauss-Legendre
+  in log f, :data:`NOISE_NODES` nodes per band);
+* **time response**: the station's acceleration at the mount point through the continuous
+  closed loop (:func:`control.forced_response`, exact for input linear between samples): the
+  platform acceleration, the stroke and the actuator force.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from microg.errors import InputError
+from microg.isolation.active.controller import Controller, loop_margin_values
+from microg.isolation.active.plant import DOF_NAMES, ActivePlant, gain
+
+__all__ = [
+    "LoopMargin",
+    "closed_loop",
+    "loop_margins",
+    "poles_stable",
+    "transmissibility_matrix",
+    "disturbance_response",
+    "noise_psd",
+    "noise_band_rms",
+    "time_response",
+    "NOISE_NODES",
+]
+
+#: the loops' frequency responses for the margins: points, lowest frequency (Hz); the margins
+#: are read from them by :func:`control.stability_margins` (interpolated between points)
+MARGIN_POINTS = 1500
+MARGIN_F_LO_HZ = 1e-6
+#: Gauss-Legendre nodes per band for the noise floor's band RMS (in log f)
+NOISE_NODES = 24
+
+
+@dataclass(frozen=True)
+class LoopMargin:
+    """Margins of one loop broken at its actuator with the others closed.
+
+    Attributes
+    ----------
+    loop : ``x``, ``y``, ``z``, ``rx``, ``ry`` or ``rz``
+    model : ``continuous`` (Pade delay) or ``discrete`` (sampled)
+    gain_margin : factor (inf: no phase crossover; below 1: a gain *reduction* by it destabilises)
+    gain_margin_db : dB
+    phase_margin_deg : degrees (inf: no gain crossover)
+    gain_crossover_hz : where |L| = 1, Hz (None: none)
+    phase_crossover_hz : where the phase crosses -180 deg, Hz (None: none)
+    """
+
+    loop: str
+    model: str
+    gain_margin: float
+    phase_margin_deg: float
+    gain_crossover_hz: float | None
+    phase_crossover_hz: float | None
+
+    @property
+    def gain_margin_db(self) -> float:
+        """Gain margin, dB."""
+        return 20 * math.log10(self.gain_margin) if self.gain_margin > 0 else -math.inf
+
+    @property
+    def gain_margin_factor(self) -> float:
+        """Distance of the gain margin from 1, ``max(gm, 1/gm)`` (>= 1)."""
+        g = self.gain_margin
+        return max(g, 1.0 / g) if g > 0 else 1.0
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready margins (an infinite margin is ``"inf"``)."""
+
+        def num(v: float | None) -> float | str | None:
+            if v is None:
+                return None
+            return float(v) if math.isfinite(v) else ("inf" if v > 0 else "-inf")
+
+        return {
+            "gain_margin": num(self.gain_margin),
+            "gain_margin_db": num(self.gain_margin_db),
+            "phase_margin_deg": num(self.phase_margin_deg),
+            "gain_crossover_hz": num(self.gain_crossover_hz),
+            "phase_crossover_hz": num(self.phase_crossover_hz),
+        }
+
+
+def _select(n_out: int, rows: list[int] | range, dt: float | None = None) -> Any:
+    m = np.zeros((len(rows), n_out))
+    m[np.arange(len(rows)), list(rows)] = 1.0
+    return gain(m, dt)
+
+
+def _inputs(n_in: int, cols: list[int] | range, dt: float | None = None) -> Any:
+    m = np.zeros((n_in, len(cols)))
+    m[list(cols), np.arange(len(cols))] = 1.0
+    return gain(m, dt)
+
+
+def _controller(plant: ActivePlant, controller: Controller, discrete: bool) -> Any:
+    import control as ct
+
+    k = controller.system
+    if not discrete:
+        return k
+    dt = 1.0 / plant.sample_rate_hz
+    if k.nstates == 0:
+        return gain(np.asarray(k.D, float), dt)
+    return ct.c2d(k, dt, "tustin")
+
+
+def closed_loop(
+    plant: ActivePlant, controller: Controller, *, discrete: bool = False, pade_order: int = 3
+) -> Any:
+    """Closed loop ``[a0 (3), d (6), n_a (6), n_p (6)] -> [a (6), q (6), f (6)]``.
+
+    Parameters
+    ----------
+    plant, controller : the isolator
+    discrete : the sampled model instead of the continuous one
+    pade_order : order of the delay's Pade approximant (continuous model)
+
+    With the controller off (``u = 0``) the continuous loop is the platform on its umbilicals
+    alone (12 states): the sensors and the delay carry nothing to the platform.
+    """
+    if controller.kind == "off" and not discrete:
+        # u = 0: the platform on its umbilicals alone (the sensors and the delay carry nothing)
+        feed = np.zeros((15, 21))
+        feed[:9, :9] = np.eye(9)
+        return plant.physical() * gain(feed)
+    gen = plant.generalized(pade_order, discrete=discrete)
+    k = _controller(plant, controller, discrete)
+    return gen.lft(k, nu=6, ny=12)
+
+
+def poles_stable(system: Any) -> tuple[bool, float]:
+    """(all poles stable, the least stability margin): max Re(p) or max |p| - 1."""
+    p = np.asarray(system.poles())
+    if p.size == 0:
+        return True, -math.inf
+    worst = float(np.max(np.abs(p)) - 1.0) if system.isdtime(strict=True) else float(np.max(p.real))
+    return worst < 0.0, worst
+
+
+def loop_margins(
+    plant: ActivePlant,
+    controller: Controller,
+    *,
+    discrete: bool = False,
+    pade_order: int = 3,
+    freq_hz: np.ndarray | None = None,
+) -> tuple[list[LoopMargin], np.ndarray]:
+    """Margins of each loop broken at its actuator, the other five closed (module docstring).
+
+    Returns the margins and each loop's response ``L_i`` at ``freq_hz`` (6, nf), complex.
+    """
+    import control as ct
+
+    gen = plant.generalized(pade_order, discrete=discrete)
+    dt = 1.0 / plant.sample_rate_hz if discrete else None
+    k = _controller(plant, controller, discrete)
+    p_yu = _select(30, range(18, 30), dt) * gen * _inputs(27, range(21, 27), dt)
+    h = k * p_yu
+    model = "discrete" if discrete else "continuous"
+    f_top = 0.499 * plant.sample_rate_hz if discrete else 20.0 * plant.sample_rate_hz
+    omega = 2 * math.pi * np.geomspace(MARGIN_F_LO_HZ, f_top, MARGIN_POINTS)
+    out = []
+    fr = np.asarray(freq_hz if freq_hz is not None else [], float)
+    resp = np.zeros((6, fr.size), complex)
+    for i, name in enumerate(DOF_NAMES):
+        e = np.eye(6)
+        e[i, i] = 0.0
+        closed = ct.feedback(h, gain(e, dt), sign=1)
+        li = -(_select(6, [i], dt) * closed * _inputs(6, [i], dt))
+        gm, pm, wgc, wpc = loop_margin_values(li, omega)
+        if fr.size:
+            resp[i] = _fresp(li, fr)[0, 0]
+        out.append(
+            LoopMargin(
+                loop=name,
+                model=model,
+                gain_margin=_num(gm),
+                phase_margin_deg=_num(pm),
+                gain_crossover_hz=_freq(wgc),
+                phase_crossover_hz=_freq(wpc),
+            )
+        )
+    return out, resp
+
+
+def _num(v: Any) -> float:
+    if v is None:
+        return math.inf
+    v = float(v)
+    return math.inf if math.isnan(v) else v
+
+
+def _freq(w: Any) -> float | None:
+    if w is None:
+        return None
+    w = float(w)
+    return None if not math.isfinite(w) else w / (2 * math.pi)
+
+
+def _fresp(system: Any, freq_hz: np.ndarray) -> np.ndarray:
+    """Complex frequency response (nout, nin, nf) at ``freq_hz``."""
+    w = 2 * math.pi * np.asarray(freq_hz, float)
+    resp = system.frequency_response(w, squeeze=False)
+    return np.asarray(resp.complex, complex).reshape(system.noutputs, system.ninputs, w.size)
+
+
+def transmissibility_matrix(cl: Any, freq_hz: np.ndarray) -> np.ndarray:
+    """Base (x, y, z) to platform linear acceleration, complex (3, 3, nf)."""
+    sub = _select(18, range(3)) * cl * _inputs(21, range(3))
+    return _fresp(sub, freq_hz)
+
+
+def disturbance_response(cl: Any, freq_hz: np.ndarray) -> np.ndarray:
+    """Force/torque on the platform to its acceleration, complex (6, 6, nf), SI per N or N m."""
+    sub = _select(18, range(6)) * cl * _inputs(21, range(3, 9))
+    return _fresp(sub, freq_hz)
+
+
+def noise_psd(cl: Any, plant: ActivePlant, freq_hz: np.ndarray) -> np.ndarray:
+    """Platform linear-acceleration PSD from the sensors' noises, (3, nf), (m/s^2)^2/Hz."""
+    sub = _select(18, range(3)) * cl * _inputs(21, range(9, 21))
+    h = _fresp(sub, freq_hz)
+    s = np.concatenate([np.full(6, plant.accel_noise_psd), np.full(6, plant.position_noise_psd)])
+    return np.einsum("ijf,j->if", np.abs(h) ** 2, s)
+
+
+def noise_band_rms(
+    cl: Any, plant: ActivePlant, lower_hz: np.ndarray, upper_hz: np.ndarray
+) -> np.ndarray:
+    """Band RMS of the noise floor per axis, (3, nb), m/s^2 (Gauss-Legendre in log f)."""
+    lo = np.asarray(lower_hz, float)
+    hi = np.asarray(upper_hz, float)
+    x, wq = np.polynomial.legendre.leggauss(NOISE_NODES)
+    u = 0.5 * (x + 1.0)  # on [0, 1]
+    lf = np.log(lo)[:, None] + (np.log(hi) - np.log(lo))[:, None] * u[None, :]
+    f = np.exp(lf)  # (nb, nodes)
+    psd = noise_psd(cl, plant, f.ravel()).reshape(3, *f.shape)
+    jac = (np.log(hi) - np.log(lo))[:, None] * 0.5 * wq[None, :] * f  # df = f dlnf
+    return np.sqrt(np.sum(psd * jac[None], axis=2))
+
+
+def time_response(
+    cl: Any, timepts: np.ndarray, base_accel: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Platform linear acceleration (3, nt), relative motion q (6, nt), force f (6, nt).
+
+    Parameters
+    ----------
+    cl : the continuous closed loop (:func:`closed_loop`)
+    timepts : (nt,) equally spaced times, s
+    base_accel : (3, nt) the mount point's acceleration, m/s^2 (linear between samples)
+    """
+    import control as ct
+
+    t = np.asarray(timepts, float)
+    u = np.asarray(base_accel, float)
+    if u.shape != (3, t.size):
+        raise InputError(f"needs shape (3, {t.size}), got {u.shape}", where="base_accel")
+    if t.size < 2:
+        raise InputError("needs at least 2 samples", where="timepts")
+    steps = np.diff(t)
+    if np.any(steps <= 0) or np.ptp(steps) > 1e-9 * max(float(np.mean(steps)), 1e-300) * t.size:
+        raise InputError("times must be equally spaced and increasing", where="timepts")
+    rows = list(range(3)) + list(range(6, 12)) + list(range(12, 18))
+    sub = _select(18, rows) * cl * _inputs(21, range(3))
+    res = ct.forced_response(sub, t, u)
+    y = np.asarray(res.outputs, float).reshape(len(rows), t.size)
+    return y[:3], y[3:9], y[9:15]
