@@ -49,3 +49,21 @@ def test_wtmass_must_be_a_positive_finite_number(value, capsys) -> None:
     # 0 was taken as "not given", nan was accepted
     rc, err = _run(capsys, ["modes", str(OP2), "--units", "in,lbf,s", "--wtmass", value])
     assert rc == 2 and err.startswith("microg: error: --wtmass:"), err
+
+
+@pytest.mark.parametrize(
+    "args",
+    [
+        ["modes", "ioc", "--elements", "\u0661\u0660"],  # Arabic-Indic 10: int() reads it
+        ["modes", "ioc", "--elements", "1_0"],  # int() reads 10
+        ["quasi-steady", "ioc", "--inclination", "5_1.6"],
+        ["isolate", "curve", "--k", "1_0", "--mu", "0.05", "--zeta", "0.1"],
+        ["isolate", "curve", "--k", "1", "--mu", "0.05", "--zeta", "0.1", "--r2", "0:\u0662:10"],
+        ["isolate", "tune", "--mu", "0.05", "--band", "0:1_0"],
+    ],
+    ids=lambda a: "-".join(a[:3]),
+)
+def test_plain_numbers_take_ascii_digits_only(args, capsys) -> None:
+    # the unit grammar takes ASCII digits only; the plain-number options now agree with it
+    rc, err = _run(capsys, args)
+    assert rc == 2 and "ASCII digits" in err and err.count("\n") == 1, err

@@ -17,7 +17,7 @@ import click
 
 from microg.analysis import DEFAULTS
 from microg.cli._errors import flag_errors
-from microg.cli.params import PathType, PositiveFloat
+from microg.cli.params import Integer, Number, PathType, PositiveFloat
 
 __all__ = ["analyze", "flag_errors", "write_outputs"]
 
@@ -98,7 +98,7 @@ def _weight_to_mass(text: str) -> str:
 @click.option(
     "--damping",
     "zeta",
-    type=float,
+    type=Number(),
     default=None,
     help=f"Modal damping ratio of the elastic modes, 0 <= zeta < 1. [default: "
     f"{DEFAULTS['damping']}]",
@@ -119,13 +119,13 @@ def _weight_to_mass(text: str) -> str:
 )
 @click.option(
     "--elements",
-    type=click.IntRange(1, 10000),
+    type=Integer(1, 10000),
     default=None,
     help="Elements per beam (fem) or assumed functions per beam (ritz). [default: 10 / 1]",
 )
 @click.option(
     "--n-modes",
-    type=click.IntRange(1, 2000),
+    type=Integer(1, 2000),
     default=None,
     help="Modes solved for frame models (the elastic ones up to --max-freq are used). "
     "[default: 60]",
@@ -172,7 +172,7 @@ def _weight_to_mass(text: str) -> str:
 )
 @click.option(
     "--absorber-mu",
-    type=float,
+    type=Number(),
     default=None,
     help="Add a vibration absorber of this mass ratio to the report-rule mount.",
 )

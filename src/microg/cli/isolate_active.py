@@ -12,7 +12,7 @@ from typing import Any
 import click
 
 from microg._io import dumps
-from microg.cli.params import PositiveFloat, QuantityType
+from microg.cli.params import PathType, PositiveFloat, QuantityType
 from microg.errors import InputError
 
 __all__ = ["active"]
@@ -126,7 +126,7 @@ __all__ = ["active"]
 @click.option(
     "--out",
     "out_dir",
-    type=click.Path(file_okay=False),
+    type=PathType(file_okay=False),
     default=None,
     help="write report.html, figures and result.json to this directory",
 )

@@ -20,7 +20,7 @@ import click
 import numpy as np
 
 from microg._io import dumps
-from microg.cli.params import PathType, PositiveFloat, QuantityType
+from microg.cli.params import Integer, PathType, PositiveFloat, QuantityType
 from microg.errors import InputError
 from microg.location.amap import DEFAULTS as LOCATE_DEFAULTS
 from microg.location.layout import DEFAULTS as LAYOUT_DEFAULTS
@@ -238,12 +238,12 @@ def _unit_system(station: Any, model: str) -> str | None:
     default=LOCATE_DEFAULTS["method"],
     show_default=True,
 )
-@click.option("--functions", type=click.IntRange(1, 40), default=None, help="Ritz: per beam (1).")
-@click.option("--elements", type=click.IntRange(1, 2000), default=None, help="FE: per beam (10).")
+@click.option("--functions", type=Integer(1, 40), default=None, help="Ritz: per beam (1).")
+@click.option("--elements", type=Integer(1, 2000), default=None, help="FE: per beam (10).")
 @click.option(
     "--n-modes",
     "n_modes",
-    type=click.IntRange(min=1),
+    type=Integer(min=1),
     default=None,
     help="Modes used (default: the solver's).",
 )
@@ -444,7 +444,7 @@ def _summary(result: Any) -> None:
 )
 @click.option(
     "--functions",
-    type=click.IntRange(1, 40),
+    type=Integer(1, 40),
     default=None,
     help="Admissible functions per beam (default 1, the report's model).",
 )
@@ -457,11 +457,11 @@ def _summary(result: Any) -> None:
     help="Objective at the site: total peak (rigid + elastic), elastic part, or bound.",
 )
 @click.option(
-    "--seed", type=click.IntRange(0, 2**32 - 1), default=LAYOUT_DEFAULTS["seed"], show_default=True
+    "--seed", type=Integer(0, 2**32 - 1), default=LAYOUT_DEFAULTS["seed"], show_default=True
 )
 @click.option(
     "--maxiter",
-    type=click.IntRange(1, MAX_GENERATIONS),
+    type=Integer(1, MAX_GENERATIONS),
     default=LAYOUT_DEFAULTS["maxiter"],
     show_default=True,
     help=f"Differential-evolution generations (at most {MAX_GENERATIONS}).",

@@ -12,7 +12,7 @@ from typing import Any
 
 import click
 
-from microg.cli.params import PathType, PositiveFloat
+from microg.cli.params import Integer, PathType, PositiveFloat
 
 __all__ = ["modes"]
 
@@ -70,20 +70,20 @@ def _effective_percent(m: Any) -> dict[str, Any]:
 )
 @click.option(
     "--functions",
-    type=click.IntRange(1, 16),
+    type=Integer(1, 16),
     default=None,
     help="Ritz: admissible functions per beam and deformation kind (default 1).",
 )
 @click.option(
     "--elements",
-    type=click.IntRange(1, 10000),
+    type=Integer(1, 10000),
     default=None,
     help="FE: minimum elements per beam (default 10; more where masses and joints cut it).",
 )
 @click.option(
     "--n-modes",
     "n_modes",
-    type=click.IntRange(1, 2000),
+    type=Integer(1, 2000),
     default=None,
     help="Number of lowest modes, at least the rigid-body ones (Ritz default: all; FE "
     "default: 20).",

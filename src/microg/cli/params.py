@@ -7,6 +7,7 @@ physical limits of :data:`microg.units.LIMITS`.
 from __future__ import annotations
 
 import math
+import re
 from typing import Any
 
 import click
@@ -21,7 +22,23 @@ __all__ = [
     "BandType",
     "PositiveFloat",
     "PathType",
+    "Integer",
+    "Number",
 ]
+
+#: a plain number as written in ASCII: Python's own parsing also takes other scripts' digits
+#: ("\u0661\u0660" is 10) and underscores ("1_0" is 10), which the unit grammar refuses
+_ASCII_INT = re.compile(r"[+-]?[0-9]+")
+_ASCII_FLOAT = re.compile(
+    r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?|[+-]?(?:inf|nan)", re.I
+)
+
+
+def _ascii(value: Any, pattern: re.Pattern[str], kind: str, param: Any, ctx: Any) -> None:
+    """Fail unless a text ``value`` is a plain ASCII number of ``pattern``."""
+    if isinstance(value, str) and pattern.fullmatch(value.strip()) is None:
+        shown = value if len(value) <= 40 else value[:40] + "..."
+        raise click.BadParameter(f"expected {kind} in ASCII digits, got {shown!r}", ctx, param)
 
 
 class QuantityType(click.ParamType):
@@ -133,6 +150,7 @@ class PositiveFloat(click.ParamType):
 
     def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
         """The finite float of ``value``, checked against the lower bound."""
+        _ascii(value, _ASCII_FLOAT, "a number", param, ctx)
         try:
             x = float(value)
         except (TypeError, ValueError):
@@ -161,6 +179,8 @@ class RangeType(click.ParamType):
         parts = str(value).split(":")
         if len(parts) != 3:
             self.fail(f"expected START:STOP:N, got {value!r}", param, ctx)
+        for part, pattern in zip(parts, (_ASCII_FLOAT, _ASCII_FLOAT, _ASCII_INT), strict=True):
+            _ascii(part, pattern, "START:STOP:N", param, ctx)
         try:
             start, stop = float(parts[0]), float(parts[1])
         except ValueError:
@@ -190,6 +210,8 @@ class BandType(click.ParamType):
         parts = str(value).split(":")
         if len(parts) != 2:
             self.fail(f"expected LO:HI, got {value!r}", param, ctx)
+        for part in parts:
+            _ascii(part, _ASCII_FLOAT, "LO:HI numbers", param, ctx)
         try:
             lo, hi = float(parts[0]), float(parts[1])
         except ValueError:
@@ -214,3 +236,24 @@ class PathType(click.Path):
         if "\x00" in text:
             self.fail("holds a NUL character: name a plain file or directory", param, ctx)
         return super().convert(value, param, ctx)
+
+
+class Integer(click.IntRange):
+    """click's integer range, in ASCII digits only (no ``"1_0"``, no other scripts' digits)."""
+
+    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
+        """The integer of ``value``, after the ASCII check, within the range."""
+        _ascii(value, _ASCII_INT, "an integer", param, ctx)
+        return super().convert(value, param, ctx)
+
+
+class Number(click.FloatRange):
+    """click's float range, in ASCII digits only, finite unless a bound says otherwise."""
+
+    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
+        """The float of ``value``, after the ASCII and finiteness checks, within the range."""
+        _ascii(value, _ASCII_FLOAT, "a number", param, ctx)
+        x = super().convert(value, param, ctx)
+        if not math.isfinite(x):
+            self.fail(f"expected a finite number, got {value!r}", param, ctx)
+        return x

@@ -12,7 +12,7 @@ from typing import Any
 
 import click
 
-from microg.cli.params import PathType
+from microg.cli.params import Integer, Number, PathType
 from microg.errors import InputError
 
 __all__ = ["quasi_steady", "FLAGS"]
@@ -115,9 +115,11 @@ def _vector(text: str | None, where: str, *, accel: bool = False) -> list[float]
     "--radius", default=None, help="Orbit radius (default: the model's orbit), e.g. '6778 km'."
 )
 @click.option("--altitude", default=None, help="Orbit altitude above the equatorial radius.")
-@click.option("--inclination", type=float, default=51.6, show_default=True, help="Degrees.")
-@click.option("--raan", type=float, default=0.0, show_default=True, help="Node, degrees.")
-@click.option("--samples", type=int, default=180, show_default=True, help="Samples over one orbit.")
+@click.option("--inclination", type=Number(), default=51.6, show_default=True, help="Degrees.")
+@click.option("--raan", type=Number(), default=0.0, show_default=True, help="Node, degrees.")
+@click.option(
+    "--samples", type=Integer(), default=180, show_default=True, help="Samples over one orbit."
+)
 @click.option(
     "--ballistic-coefficient",
     "ballistic_coefficient",
@@ -125,7 +127,7 @@ def _vector(text: str | None, where: str, *, accel: bool = False) -> list[float]
     help="m / (Cd A), e.g. '100 kg/m^2' (or give --area and --cd).",
 )
 @click.option("--area", default=None, help="Reference area for drag, e.g. '900 m^2'.")
-@click.option("--cd", type=float, default=None, help="Drag coefficient with --area [2.2].")
+@click.option("--cd", type=Number(), default=None, help="Drag coefficient with --area [2.2].")
 @click.option("--mass", default=None, help="Mass for drag with --area (default: the model's).")
 @click.option(
     "--atmosphere",
@@ -135,13 +137,13 @@ def _vector(text: str | None, where: str, *, accel: bool = False) -> list[float]
     help="NRLMSIS 2.1 (pymsis) or the exponential atmosphere (Vallado 2013 Table 8-4).",
 )
 @click.option("--date", default=None, help="UTC date and time, e.g. 2024-03-20T12:00:00.")
-@click.option("--f107", type=float, default=None, help="Daily F10.7, sfu [150].")
-@click.option("--f107a", type=float, default=None, help="81-day mean F10.7, sfu [150].")
-@click.option("--ap", type=float, default=None, help="Daily Ap index [15].")
+@click.option("--f107", type=Number(), default=None, help="Daily F10.7, sfu [150].")
+@click.option("--f107a", type=Number(), default=None, help="81-day mean F10.7, sfu [150].")
+@click.option("--ap", type=Number(), default=None, help="Daily Ap index [15].")
 @click.option("--point", "points", multiple=True, help="Named point to report (repeatable).")
 @click.option(
     "--elements",
-    type=click.IntRange(1, 200),
+    type=Integer(1, 200),
     default=20,
     show_default=True,
     help="Frame elements per beam of the map's sample points.",

@@ -14,7 +14,7 @@ from pathlib import Path
 import click
 
 from microg.cli._errors import flag_errors
-from microg.cli.params import PathType
+from microg.cli.params import Integer, Number, PathType
 
 __all__ = ["sweep"]
 
@@ -42,7 +42,7 @@ FLAGS = {
 )
 @click.option(
     "--workers",
-    type=click.IntRange(1, 1024),
+    type=Integer(1, 1024),
     default=None,
     help="Start a local Dask cluster of N worker processes (one thread each).",
 )
@@ -54,7 +54,7 @@ FLAGS = {
 )
 @click.option(
     "--timeout",
-    type=click.FloatRange(0, 3600, min_open=True),
+    type=Number(0, 3600, min_open=True),
     default=10.0,
     show_default=True,
     help="Seconds to wait for --scheduler to answer and to have a worker.",
