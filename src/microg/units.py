@@ -43,6 +43,7 @@ __all__ = [
     "SLUG",
     "DIMENSIONS",
     "LIMITS",
+    "SMALLEST",
     "MAX_TEXT",
     "MAX_POWER",
     "QUANTITY_FORM",
@@ -109,6 +110,14 @@ LIMITS: dict[str, float] = {
     "damping": 1e12,  # N s/m
     "gravitational_parameter": 1e18,  # m^3/s^2 (the Earth: 3.986e14)
     "force_per_length": 1e7,  # N/m
+}
+
+#: the smallest non-zero magnitude accepted, per dimension where one matters: a frequency
+#: below 1e-9 Hz (a period of 32 years) is no vibration of a station, and its reciprocal
+#: powers overflow
+SMALLEST: dict[str, float] = {
+    "frequency": 1e-9,  # Hz
+    "angular_frequency": 2e-9 * math.pi,  # rad/s
 }
 
 #: longest quantity text accepted, characters
@@ -616,6 +625,10 @@ def parse_unit(text: str, dimension: str, *, where: str) -> float:
         raise InputError(f"unit {text.strip()!r} {bad.what}", where=where, fix=bad.fix) from None
 
 
+def _article(word: str) -> str:
+    return "an" if word[:1] in "aeiou" else "a"
+
+
 def check_limit(value: float, dimension: str, *, where: str) -> float:
     """``value`` (SI) if ``|value| <= LIMITS[dimension]``, else a one-line :class:`InputError`.
 
@@ -636,8 +649,17 @@ def check_limit(value: float, dimension: str, *, where: str) -> float:
     if abs(value) > limit:
         si = DIMENSIONS[dimension]
         raise InputError(
-            f"{value:.6g} {si} is beyond the physical limit of {limit:.6g} {si} for a "
-            f"{dimension.replace('_', ' ')}",
+            f"{value:.6g} {si} is beyond the physical limit of {limit:.6g} {si} for "
+            f"{_article(dimension)} {dimension.replace('_', ' ')}",
+            where=where,
+            fix="check the value and its unit (limits: docs/model-format.md)",
+        )
+    small = SMALLEST.get(dimension, 0.0)
+    if 0.0 < abs(value) < small:
+        si = DIMENSIONS[dimension]
+        raise InputError(
+            f"{value:.6g} {si} is below the smallest {dimension.replace('_', ' ')} accepted, "
+            f"{small:.6g} {si}",
             where=where,
             fix="check the value and its unit (limits: docs/model-format.md)",
         )

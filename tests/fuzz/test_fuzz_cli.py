@@ -36,7 +36,7 @@ from microg.cli.params import MassOrWeightType, QuantityType
 from microg.dynamics.crew import MIN_RAMP_S
 from microg.dynamics.forces import activity_library, parse_force_spec
 from microg.errors import InputError
-from microg.units import LIMITS
+from microg.units import LIMITS, SMALLEST
 
 ROOT = Path(__file__).resolve().parents[2]
 EXAMPLE = ROOT / "examples" / "station.toml"
@@ -139,6 +139,7 @@ def quantity_cases(draw: st.DrawFn, dim: str | None = None) -> dict[str, Any]:
     if valid:
         value = x * factor
         valid = math.isfinite(value) and abs(value) <= LIMITS[dim]
+        valid = valid and not (0 < abs(value) < SMALLEST.get(dim, 0.0))
     return {"dim": dim, "text": text, "kind": kind, "expected": (x * factor) if valid else None}
 
 

@@ -124,3 +124,30 @@ def test_range_too_large(capsys) -> None:
     )
     err = capsys.readouterr().err
     assert rc == 2 and "--r2" in err and err.count("\n") == 1
+
+
+@pytest.mark.parametrize(
+    ("args", "flag"),
+    [
+        (["design", "--mass", "100 kg", "--freq", "1e-300 Hz", "--mu", "0.05"], "--freq"),
+        (["design", "--mass", "100 kg", "--freq", "1e-320 Hz"], "--freq"),
+        (["design", "--mass", "100 kg", "--omega", "1e-300 rad/s", "--mu", "0.05"], "--omega"),
+        (["design", "--mass", "100 kg", "--freq-band", "1e-320:1", "--mu", "0.05"], "band"),
+        (["design", "--mass", "100 kg", "--freq-band", "0.1:1e300", "--mu", "0.05"], "band"),
+        (["design", "--mass", "100 kg", "--freq-band", "0.1:1", "--mu", "1e-320"], "--mu"),
+        (["design", "--mass", "100 kg", "--freq-band", "0.1:1", "--mu", "1e300"], "--mu"),
+        (["tune", "--mu", "1e-320"], "--mu"),
+        (["tune", "--mu", "1e300"], "--mu"),
+        (["tune", "--mu", "0.05", "--band", "1e-320:1"], "--band"),
+        (["claims", "--mu-max", "1e-320"], "--mu-max"),
+        (["claims", "--mu-max", "1e300"], "--mu-max"),
+    ],
+)
+def test_extreme_values_are_refused_in_one_line(args, flag, capsys) -> None:
+    # each was an internal error (overflow in 1/(f^2 mu), a bisection on 1e-300): now outside
+    # the documented ranges (microg.units.SMALLEST, absorber.MU_RANGE), one line, exit 2
+    from microg.cli import main
+
+    rc = main(["isolate", *args])
+    err = capsys.readouterr().err
+    assert rc == 2 and err.count("\n") == 1 and flag in err.split(":")[2], err

@@ -6,7 +6,9 @@ The command computes nothing itself; it parses options (units at the boundary), 
 
 from __future__ import annotations
 
+import functools
 import math
+from collections.abc import Callable
 from typing import Any
 
 import click
@@ -19,6 +21,29 @@ from microg.units import LBF
 __all__ = ["isolate"]
 
 _LBF_PER_N = 1.0 / LBF
+
+
+#: library parameter -> option, for the one-line errors
+FLAGS = {
+    "mu": "--mu",
+    "mu_max": "--mu-max",
+    "band": "--band",
+    "omega band": "--omega-band/--freq-band",
+    "mass": "--mass/--weight",
+    "target": "--target",
+}
+
+
+def _flagged(command: Callable[..., Any]) -> Callable[..., Any]:
+    """Run ``command`` with the library's parameter names shown as this group's options."""
+    from microg.cli._errors import flag_errors
+
+    @functools.wraps(command)
+    def run(*args: Any, **kwargs: Any) -> Any:
+        with flag_errors(FLAGS):
+            return command(*args, **kwargs)
+
+    return run
 
 
 def _nonneg_range(ctx: click.Context, param: click.Parameter, value: Any) -> Any:
@@ -61,6 +86,7 @@ def isolate() -> None:
     help="r^2 samples START:STOP:N (inclusive)",
 )
 @click.option("--json", "as_json", is_flag=True, help="print {'r2': [...], 'Ma': [...]}")
+@_flagged
 def curve(k: float, mu: float, zeta: float, r2: tuple[float, float, int], as_json: bool) -> None:
     """M_a = |U1/U0| against r^2 (Eq. 4.3 solved; printed Eq. 4.7 is garbled)."""
     from microg.isolation import (
@@ -106,6 +132,7 @@ def curve(k: float, mu: float, zeta: float, r2: tuple[float, float, int], as_jso
     help="hold the absorber damping ratio fixed (default: optimised)",
 )
 @click.option("--json", "as_json", is_flag=True, help="print {k, zeta, f, peak_Ma, criterion}")
+@_flagged
 def tune(
     mu: float,
     band: tuple[float, float] | None,
@@ -182,6 +209,7 @@ def tune(
     help="with --mu: hold the absorber damping ratio fixed",
 )
 @click.option("--json", "as_json", is_flag=True, help="print the design as a JSON object")
+@_flagged
 def design(
     weight: float | None,
     mass: float | None,
@@ -254,6 +282,7 @@ def design(
     help="largest absorber mass ratio searched for claim (d)",
 )
 @click.option("--json", "as_json", is_flag=True, help="print the checks as JSON")
+@_flagged
 def claims(mu_max: float, as_json: bool) -> None:
     """Recompute the numerical claims of Section 4.2 and conclusion 5 of the report."""
     from microg.isolation import check_section42_claims
@@ -285,6 +314,7 @@ def claims(mu_max: float, as_json: bool) -> None:
     show_default=True,
     help="upper end of the r^2 axis",
 )
+@_flagged
 def figure8(out: str, r2_max: float) -> None:
     """Figure 8: M_a against r^2, six panels at zeta = 0.2."""
     from pathlib import Path

@@ -157,10 +157,25 @@ class AbsorberTuning:
         }
 
 
-def _check_mu(mu: float) -> float:
-    mu = float(mu)
-    if not (math.isfinite(mu) and mu > 0):
-        raise InputError(f"mass ratio must be a finite number > 0, got {mu!r}", where="mu")
+#: absorber mass ratios m2/m1 accepted: from an absorber of a millionth of the package to one
+#: a hundred times heavier (outside it the fixed-point formulas of Eqs. 4.3-4.7 overflow or
+#: lose every digit; no design lies there)
+MU_RANGE = (1e-6, 100.0)
+
+
+def _check_mu(mu: float, where: str = "mu") -> float:
+    """``mu`` as a float if it is a mass ratio within :data:`MU_RANGE`, else an InputError."""
+    try:
+        mu = float(mu)
+    except (TypeError, ValueError):
+        raise InputError(f"mass ratio must be a number, got {mu!r}", where=where) from None
+    lo, hi = MU_RANGE
+    if not (math.isfinite(mu) and lo <= mu <= hi):
+        raise InputError(
+            f"mass ratio must be a finite number from {lo:g} to {hi:g}, got {mu!r}",
+            where=where,
+            fix="give the absorber's mass over the package's, e.g. 0.05",
+        )
     return mu
 
 
@@ -170,7 +185,18 @@ def _check_band(band: tuple[float, float] | None) -> tuple[float, float] | None:
     lo, hi = float(band[0]), float(band[1])
     if not (0.0 <= lo < hi < math.inf):
         raise InputError(f"need 0 <= LO < HI < inf, got {band!r}", where="band")
+    if hi > MAX_RATIO or 0.0 < lo < 1.0 / MAX_RATIO:
+        raise InputError(
+            f"frequency ratios must lie from {1 / MAX_RATIO:g} to {MAX_RATIO:g} (or LO = 0), "
+            f"got {band!r}",
+            where="band",
+        )
     return (lo, hi)
+
+
+#: largest frequency ratio r = omega/omega_2 of a tuning band (six decades either side of
+#: the absorber's own frequency hold every band a design can use)
+MAX_RATIO = 1e6
 
 
 def den_hartog_peak_bound(mu: float) -> float:

@@ -293,7 +293,10 @@ def _active_check(
             requirement=requirement,
         )
     except InputError as exc:
-        return None, f"the {ACTIVE_PRESET.upper()}-class active isolator could not be designed ({exc})"  # noqa: E501
+        return (
+            None,
+            f"the {ACTIVE_PRESET.upper()}-class active isolator could not be designed ({exc})",
+        )  # noqa: E501
     tm = act.time
     stroke = float(tm.peak_stroke[:3].max()) if tm is not None else float("nan")
     force = float(tm.peak_force[:3].max()) if tm is not None else float("nan")
@@ -312,7 +315,10 @@ def _active_check(
             f"complies in the time domain with the sensor noise included ({facts})"
         )
     why = act.binding_limit or (
-        "stability" if not act.stable else "the loop margins" if not act.margins_kept
+        "stability"
+        if not act.stable
+        else "the loop margins"
+        if not act.margins_kept
         else "the platform's band verdict"
     )
     return act, (

@@ -15,12 +15,12 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from microg.errors import InputError
-from microg.isolation.absorber import AbsorberTuning, tune_absorber
+from microg.isolation.absorber import AbsorberTuning, _check_mu, tune_absorber
 from microg.isolation.transmissibility import (
     accel_magnification,
     accel_magnification_no_absorber,
 )
-from microg.units import G0, G0_US, IN, LBF
+from microg.units import G0, G0_US, IN, LBF, check_limit
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -181,6 +181,8 @@ def _validate_design(mass: float, band: tuple[float, float], target: float) -> N
     lo, hi = band
     if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo <= hi):
         raise InputError(f"need 0 < LO <= HI < inf, got {band!r}", where="omega band")
+    for value in (lo, hi):  # one documented range for every frequency (microg.units)
+        check_limit(value, "angular_frequency", where="omega band")
     if not (math.isfinite(target) and 0 < target <= 1):
         raise InputError(
             f"must be in (0, 1], got {target!r}",
@@ -224,8 +226,7 @@ def design_mount(
         wn = math.sqrt(k1 / mass)
         achieved = float(accel_magnification_no_absorber(lo / wn))
         return _finish(mass, (lo, hi), target, k1, achieved)
-    if not (math.isfinite(mu) and mu > 0):
-        raise InputError(f"must be a finite number > 0, got {mu!r}", where="mu")
+    mu = _check_mu(mu)
     if hi <= lo:
         raise InputError(
             "an absorber design needs a band of frequencies",
@@ -458,6 +459,7 @@ def check_section42_claims(
     mu_max : float
         Largest practical absorber mass ratio searched for claim (d).
     """
+    mu_max = _check_mu(mu_max, where="mu_max")
     m1 = weight_lbf / G0_US  # slug
     k_max = {w: m1 * w * w / 2.0 for w in (omega, omega_fundamental, omega_lowest_bending)}  # lb/ft
     k_printed_lb_ft = 5.0 * 12.0
