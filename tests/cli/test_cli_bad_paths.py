@@ -67,3 +67,43 @@ def test_plain_numbers_take_ascii_digits_only(args, capsys) -> None:
     # the unit grammar takes ASCII digits only; the plain-number options now agree with it
     rc, err = _run(capsys, args)
     assert rc == 2 and "ASCII digits" in err and err.count("\n") == 1, err
+
+
+def test_an_overflowing_body_rate_is_refused(capsys) -> None:
+    # 1e300 rad/s gave 155 nulls and "complies": null with exit 0
+    rc, err = _run(capsys, ["quasi-steady", "ioc", "--attitude", "rate", "--rate", "0 0 1e300"])
+    assert rc == 2 and err.startswith("microg: error: --rate:") and err.count("\n") == 1, err
+
+
+def test_warnings_before_an_error_are_not_shown(capsys, monkeypatch) -> None:
+    # a numpy RuntimeWarning raised on the way to a refusal: the error is the one line
+    import warnings
+
+    import microg.cli.modes as modes_cli
+    from microg.errors import InputError
+
+    def load(*a, **k):
+        warnings.warn("overflow encountered in multiply", RuntimeWarning, stacklevel=1)
+        raise InputError("bad model", where="MODEL")
+
+    monkeypatch.setattr(modes_cli, "discretize", load, raising=False)
+    monkeypatch.setattr("microg.structure.discretize.discretize", load)
+    rc, err = _run(capsys, ["modes", "ioc"])
+    assert rc == 2 and err == "microg: error: MODEL: bad model\n", err
+
+
+def test_a_warning_after_success_is_one_line(capsys, monkeypatch) -> None:
+    import warnings
+
+    import microg.isolation
+
+    real = microg.isolation.check_section42_claims
+
+    def claims(*a, **k):
+        for _ in range(2):  # the same warning twice is shown once
+            warnings.warn("first line\nsecond line", UserWarning, stacklevel=1)
+        return real(*a, **k)
+
+    monkeypatch.setattr("microg.isolation.check_section42_claims", claims)
+    rc, err = _run(capsys, ["isolate", "claims"])
+    assert rc == 0 and err == "microg: warning: first line second line (UserWarning)\n", err

@@ -92,7 +92,24 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _run(argv: list[str] | None) -> int:
-    """:func:`main`'s body: the command, every error turned into one line and a status."""
+    """:func:`main`'s body: warnings gathered, each shown as one line after a success only."""
+    import warnings
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("default")
+        status = _status(argv)
+    if status == 0:
+        seen: set[str] = set()
+        for w in caught:
+            line = f"microg: warning: {_one_line(str(w.message))[:300]} ({w.category.__name__})"
+            if line not in seen:
+                seen.add(line)
+                click.echo(line, err=True)
+    return status
+
+
+def _status(argv: list[str] | None) -> int:
+    """The command run, every error turned into one line and a status."""
     try:
         status = cli.main(args=argv, prog_name="microg", standalone_mode=False)
     except click.exceptions.NoSuchOption as exc:

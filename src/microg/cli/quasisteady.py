@@ -69,7 +69,7 @@ def _derived(text: str, where: str, unit_si: str, base: str, times: str) -> floa
 
 def _vector(text: str | None, where: str, *, accel: bool = False) -> list[float] | None:
     """Three components ``"x y z [unit]"`` (rad/s or rad/s^2 by default)."""
-    from microg.units import parse_quantity
+    from microg.units import LIMITS, parse_quantity
 
     if text is None:
         return None
@@ -90,7 +90,15 @@ def _vector(text: str | None, where: str, *, accel: bool = False) -> list[float]
                 _derived(f"{p} {unit or 'rad/s^2'}", where, "rad/s^2", "angular_frequency", "s")
             )
         else:
-            out.append(parse_quantity(f"{p} {unit or 'rad/s'}", "angular_frequency", where=where))
+            q = parse_quantity(f"{p} {unit or 'rad/s'}", "angular_frequency", where=where)
+            if abs(q) > LIMITS["angular_frequency"]:  # a rate, however small, may be 0 or tiny
+                raise InputError(
+                    f"{p} {unit or 'rad/s'} is beyond the physical limit of "
+                    f"{LIMITS['angular_frequency']:.6g} rad/s",
+                    where=where,
+                    fix="check the value and its unit",
+                )
+            out.append(q)
     return out
 
 
