@@ -107,3 +107,19 @@ def test_a_warning_after_success_is_one_line(capsys, monkeypatch) -> None:
     monkeypatch.setattr("microg.isolation.check_section42_claims", claims)
     rc, err = _run(capsys, ["isolate", "claims"])
     assert rc == 0 and err == "microg: warning: first line second line (UserWarning)\n", err
+
+
+@pytest.mark.parametrize(
+    "args",
+    [
+        ["analyze", "ioc", "--wtmass", "1"],
+        ["modes", "ioc", "--units", "in,lbf,s"],
+        ["modes", "ioc", "--units", "parsecs,N,s"],
+    ],
+    ids=lambda a: a[2],
+)
+def test_reader_options_for_a_station_are_refused(args, capsys, tmp_path) -> None:
+    # a station declares its own units: --units/--wtmass were accepted and ignored (exit 0)
+    rc, err = _run(capsys, [*args, "--out", str(tmp_path / "o")] if args[0] == "analyze" else args)
+    assert rc == 2 and f"{args[2]}: applies to NASTRAN and UFF files only" in err, err
+    assert not (tmp_path / "o").exists()

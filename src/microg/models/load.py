@@ -63,6 +63,17 @@ def loads_station(path: str | Path, points: str | Path | None = None) -> bool:
     return points is None and (suffix == ".toml" or suffix not in MODEL_SUFFIXES)
 
 
+def _only_for_foreign_files(units: str | None, wtmass: float | None, kind: str) -> None:
+    """Refuse NASTRAN/UFF reader options given for a model that declares its own units."""
+    for name, value in (("units", units), ("wtmass", wtmass)):
+        if value is not None:
+            raise InputError(
+                f"applies to NASTRAN and UFF files only: {kind} declares its own units",
+                where=name,
+                fix="leave it out",
+            )
+
+
 def load_model(
     path: str | Path,
     units: str | None = None,
@@ -93,6 +104,7 @@ def load_model(
         # a station (a file or a shipped name): the modal readers are not needed
         from microg.models.toml import load_station
 
+        _only_for_foreign_files(units, wtmass, "a station or graph model")
         return load_station(p if suffix == ".toml" else path)
     from microg.models.modal import ModelOptions, load_modal_model, read_options
 
@@ -102,10 +114,12 @@ def load_model(
 
         if opts.points:
             raise InputError("a points file applies to modal models only", where=str(points))
+        _only_for_foreign_files(units, wtmass, "a station or graph model")
         return load_station(path)
     if suffix == ".toml":
         from microg.models.toml import load_station
 
+        _only_for_foreign_files(units, wtmass, "a station or graph model")
         return load_station(p)
     if suffix in (".bdf", ".dat"):
         try:
@@ -117,6 +131,7 @@ def load_model(
     if not p.is_file():
         raise InputError("no such file", where=label)
     if suffix == ".npz":
+        _only_for_foreign_files(units, wtmass, "microg's own modal file")
         return load_modal_model(p, points=opts.points)
     if suffix in (".unv", ".uff"):
         from microg.models.uff import modal_model_from_uff
