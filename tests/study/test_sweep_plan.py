@@ -211,3 +211,43 @@ def test_the_shipped_example_study_loads() -> None:
     s = load_study(path)
     assert s.n_cases == 2 * 2 * 3 * 3 * 3 * 2 * 2
     assert s.coords["isolator"] == ["none", "soft-mount"]
+
+
+def test_a_case_count_beyond_64_bits_is_refused() -> None:
+    # 7 axes of 520 values: 520**7 * 1 = 1.03e19 cases, past 2**63; numpy's int64 product
+    # wrapped to a negative count that passed the 100-million limit and the sweep started
+    import math
+
+    from microg.errors import InputError
+    from microg.study import loads_study
+
+    n = 520
+    lst = lambda items: "[" + ", ".join(items) + "]"  # noqa: E731
+    points = "\n".join(
+        f'[[point]]\nname = "p{i}"\non = "keel"\ns = "{10 + i * 0.5:.1f} ft"\n' for i in range(n)
+    )
+    variants = (
+        f'{{ name = "v{i}", move = "main/Orbiter", to = ["0 ft", "0 ft", "{-60 - i / 10:.1f} ft"] }}'
+        for i in range(n)
+    )
+    text = f"""[study]
+name = "huge"
+model = "ioc"
+[axes]
+force = {lst(f'"crew-pushoff:f0={1 + i * 0.1:.1f}lbf,t1=0.5s"' for i in range(n))}
+at = {lst(f'"p{i}"' for i in range(n))}
+observe = {lst(f'"p{i}"' for i in range(n))}
+direction = {lst(f'"1 {i / 600:.6f} 0"' for i in range(n))}
+damping = {lst(f"{0.001 + i * 1e-5:.6f}" for i in range(n))}
+isolator = {lst(f'{{ name = "s{i}", f_n = "{0.1 + i * 0.001:.3f} Hz"}}' for i in range(n))}
+variant = {lst(variants)}
+[record]
+duration = "40 s"
+dt = "0.1 s"
+max_freq = "2 Hz"
+
+{points}"""
+    assert math.prod([n] * 7) > 2**63  # the case this test is about
+    with pytest.raises(InputError) as info:
+        loads_study(text, filename="huge.toml")
+    assert "10,280,717,025,280,000,000 cases" in str(info.value)

@@ -461,7 +461,7 @@ class Study:
 
     def blocks(self) -> Iterator[Block]:
         """Every block holding at least one case, in storage order."""
-        for b in range(int(np.prod(self.block_grid))):
+        for b in range(math.prod(self.block_grid)):
             blk = self.block(b)
             if blk.n_cases:
                 yield blk
@@ -469,13 +469,13 @@ class Study:
     @property
     def n_blocks(self) -> int:
         """Number of blocks of the grid (with or without cases)."""
-        return int(np.prod(self.block_grid))
+        return math.prod(self.block_grid)
 
     @property
     def n_cases(self) -> int:
         """Number of cases of the plan."""
         if self.case_sets is None:
-            return int(np.prod(self.shape))
+            return math.prod(self.shape)
         return sum(b.n_cases for b in self.blocks())
 
     @property
@@ -786,7 +786,7 @@ class _Builder:
             text=self.text,
             warnings=tuple(self.warnings),
         )
-        size = int(np.prod(study.shape))
+        size = math.prod(study.shape)  # Python integers: no 64-bit overflow
         if size > MAX_CASES:
             raise self.err(
                 "axes",
