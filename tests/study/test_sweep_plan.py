@@ -227,7 +227,7 @@ def test_a_case_count_beyond_64_bits_is_refused() -> None:
         f'[[point]]\nname = "p{i}"\non = "keel"\ns = "{10 + i * 0.5:.1f} ft"\n' for i in range(n)
     )
     variants = (
-        f'{{ name = "v{i}", move = "main/Orbiter", to = ["0 ft", "0 ft", "{-60 - i / 10:.1f} ft"] }}'
+        f'{{ name = "v{i}", move = "main/Orbiter", to = ["0 ft", "0 ft", "{-60 - i / 10:.1f} ft"]}}'
         for i in range(n)
     )
     text = f"""[study]
