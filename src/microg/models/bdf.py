@@ -48,13 +48,18 @@ from typing import Any
 import numpy as np
 
 from microg.errors import InputError
+from microg.models.coords import (
+    NASTRAN_KINDS,
+    CoordinateFrame,
+    Cord2,
+    chain_cord2,
+    nastran_coordinates,
+)
 from microg.models.graph import (
-    BASIC,
     BeamElement,
     BeamSection,
     ConcentratedMass,
     Constraint,
-    CoordinateFrame,
     GraphModel,
     GraphPoint,
     Interpolation,
@@ -63,7 +68,6 @@ from microg.models.graph import (
     RodElement,
     ScalarSpring,
     Spring,
-    frame_from_points,
     parse_components,
     spring_axes,
     validate_graph,
@@ -596,50 +600,25 @@ class _Deck:
 
     def frames(self) -> dict[int, CoordinateFrame]:
         raw = self.by_id(("CORD2R", "CORD2C", "CORD2S"), "coordinate system")
-        if 0 in raw:
-            raise raw[0].error("coordinate system 0 is the basic system", "use another id")
-        kinds = {"CORD2R": "rectangular", "CORD2C": "cylindrical", "CORD2S": "spherical"}
-        out: dict[int, CoordinateFrame] = {0: BASIC}
-        pending = dict(raw)
-        while pending:
-            done = []
-            for cid, c in pending.items():
-                rid = c.integer(2, "RID", 0)
-                if rid not in out:
-                    if rid not in raw:
-                        raise c.error(
-                            f"reference system {rid} is not defined", "define it or use RID 0"
-                        )
-                    continue
-                ref = out[rid]
-                pts = []
-                for k in (3, 6, 9):
-                    v = np.array(
+        defs = [
+            Cord2(
+                cid,
+                NASTRAN_KINDS[c.name[-1]],
+                c.integer(2, "RID", 0),
+                np.array(
+                    [
                         [
                             c.real(k + m, f"point {'ABC'[(k - 3) // 3]}{m + 1}", 0.0)
                             for m in range(3)
                         ]
-                    )
-                    pts.append(ref.to_basic(self._coords(ref.kind, v)))
-                out[cid] = frame_from_points(f"cs:{cid}", kinds[c.name], *pts, where=c.where)
-                done.append(cid)
-            if not done:
-                c = next(iter(pending.values()))
-                raise c.error(
-                    "coordinate systems reference each other in a cycle", "break the RID chain"
-                )
-            for cid in done:
-                del pending[cid]
-        return out
-
-    def _coords(self, kind: str, v: np.ndarray) -> np.ndarray:
-        """Deck coordinates in a system of ``kind`` -> SI (lengths scaled, degrees to rad)."""
-        L = self.sc.length
-        if kind == "rectangular":
-            return v * L
-        if kind == "cylindrical":
-            return np.array([v[0] * L, math.radians(v[1]), v[2] * L])
-        return np.array([v[0] * L, math.radians(v[1]), math.radians(v[2])])
+                        for k in (3, 6, 9)
+                    ]
+                ),
+                c.where,
+            )
+            for cid, c in raw.items()
+        ]
+        return chain_cord2(defs, length=self.sc.length)
 
     def frame(self, frames: dict[int, CoordinateFrame], cid: int, c: Card) -> CoordinateFrame:
         if cid not in frames:
@@ -670,7 +649,7 @@ class _Deck:
                 raise c.error("fluid grids (CD = -1) are not supported")
             fr = self.frame(frames, cp, c)
             x = np.array([c.real(3 + k, f"X{k + 1}", 0.0) for k in range(3)])
-            p = fr.to_basic(self._coords(fr.kind, x))
+            p = fr.to_basic(nastran_coordinates(fr.kind, x, self.sc.length))
             fd = self.frame(frames, cd, c)
             ax = fd.axes_at(p)
             name = f"grid:{gid}"
@@ -1315,7 +1294,7 @@ class _Deck:
 
 def grid_geometry(
     path: str | Path, ids: np.ndarray
-) -> tuple[np.ndarray, np.ndarray, dict[int, Any]]:
+) -> tuple[np.ndarray, np.ndarray, dict[int, CoordinateFrame]]:
     """Positions of grids in the basic system, their output systems, and the deck's systems.
 
     For an OP2 without geometry tables: only GRID and CORD2R/C/S cards (and INCLUDEs) are
@@ -1334,11 +1313,9 @@ def grid_geometry(
         Basic coordinates, in the deck's length unit.
     cd : ndarray (g,) of int
         Each grid's output (displacement) coordinate system.
-    systems : dict of int to microg.models.nastran.CoordSystem
-        Every CORD2R/C/S, basic origin (deck length unit) and axes (columns).
+    systems : dict of int to CoordinateFrame
+        Every CORD2R/C/S by id (basic excluded), origin in the deck's length unit.
     """
-    from microg.models.nastran import CoordSystem
-
     cards, case = read_cards(path)
     keep = [c for c in cards if c.name in ("GRID", "CORD2R", "CORD2C", "CORD2S")]
     deck = _Deck(keep, case, str(path), _Scales(1.0, 1.0, 1.0), None, None)
@@ -1352,12 +1329,7 @@ def grid_geometry(
             fix="give the deck the OP2 was run from",
         )
     cd = {gid: c.integer(6, "CD", 0) for gid, c in deck.by_id(("GRID",), "grid").items()}
-    kinds = {"rectangular": "R", "cylindrical": "C", "spherical": "S"}
-    systems = {
-        int(cid): CoordSystem(int(cid), kinds[f.kind], np.asarray(f.origin, float), f.rotation.T)
-        for cid, f in frames.items()
-        if cid != 0
-    }
+    systems = {cid: f for cid, f in frames.items() if cid != 0}
     xyz = np.array([pos[int(g)] for g in ids], float).reshape(-1, 3)
     return xyz, np.array([cd[int(g)] for g in ids], int), systems
 

@@ -35,6 +35,7 @@ import numpy as np
 
 from microg._io import loads_toml
 from microg.errors import InputError, ModelError
+from microg.models.coords import BASIC, FRAME_KINDS, CoordinateFrame, frame_from_points
 
 __all__ = [
     "BASIC",
@@ -64,8 +65,6 @@ __all__ = [
 
 #: the six components of a node, NASTRAN's numbering: 1-3 translations, 4-6 rotations
 COMPONENTS = "123456"
-#: kinds of coordinate frame
-FRAME_KINDS = ("rectangular", "cylindrical", "spherical")
 #: mass formulations of beams and rods
 MASS_FORMULATIONS = ("lumped", "consistent")
 #: largest number of nodes, elements, masses... of each kind in one model (documented limit)
@@ -74,114 +73,6 @@ MAX_GRAPH_ITEMS = 2_000_000
 ZERO_LENGTH_TOL = 1e-9
 #: an orientation within this angle (rad) of the beam axis is parallel to it
 PARALLEL_TOL = 1e-6
-
-
-# --------------------------------------------------------------------------- frames
-
-
-@dataclass(frozen=True)
-class CoordinateFrame:
-    """A coordinate system: rectangular, cylindrical or spherical (NASTRAN CORD2R/C/S).
-
-    Attributes
-    ----------
-    name : str
-        ``"cs:3"`` for NASTRAN coordinate system 3.
-    kind : {"rectangular", "cylindrical", "spherical"}
-    origin : ndarray (3,)
-        Origin in the basic frame, m.
-    rotation : ndarray (3, 3)
-        Rows: the unit x, y, z axes of the system in the basic frame.
-    """
-
-    name: str
-    kind: str
-    origin: np.ndarray
-    rotation: np.ndarray
-
-    def to_basic(self, coords: np.ndarray) -> np.ndarray:
-        """Basic-frame positions (m) of points given in this system.
-
-        Rectangular ``(x, y, z)``; cylindrical ``(r, theta, z)``; spherical
-        ``(r, theta, phi)`` (NASTRAN's: theta from the z axis, phi about z from x); lengths
-        in m, angles in rad.
-        """
-        c = np.asarray(coords, float)
-        if self.kind == "cylindrical":
-            r, th, z = c[..., 0], c[..., 1], c[..., 2]
-            local = np.stack([r * np.cos(th), r * np.sin(th), z], axis=-1)
-        elif self.kind == "spherical":
-            r, th, ph = c[..., 0], c[..., 1], c[..., 2]
-            local = np.stack(
-                [r * np.sin(th) * np.cos(ph), r * np.sin(th) * np.sin(ph), r * np.cos(th)], -1
-            )
-        else:
-            local = c
-        return self.origin + local @ self.rotation
-
-    def axes_at(self, position: np.ndarray) -> np.ndarray:
-        """Unit axes (rows) of the system's components 1, 2, 3 at basic ``position``, (…, 3, 3).
-
-        Rectangular: the fixed axes.  Cylindrical: radial, tangential, axial.  Spherical:
-        radial, meridional (theta), azimuthal (phi).  On the axis (r = 0) the angles are
-        taken as 0, NASTRAN's convention.
-        """
-        p = np.asarray(position, float)
-        local = (p - self.origin) @ self.rotation.T
-        shape = (*local.shape[:-1], 3, 3)
-        if self.kind == "rectangular":
-            return np.broadcast_to(self.rotation, shape).copy()
-        x, y, z = local[..., 0], local[..., 1], local[..., 2]
-        ph = np.arctan2(y, x)
-        zero = np.zeros_like(ph)
-        one = np.ones_like(ph)
-        if self.kind == "cylindrical":
-            rows = [
-                np.stack([np.cos(ph), np.sin(ph), zero], -1),
-                np.stack([-np.sin(ph), np.cos(ph), zero], -1),
-                np.stack([zero, zero, one], -1),
-            ]
-        else:
-            th = np.arctan2(np.hypot(x, y), z)
-            rows = [
-                np.stack([np.sin(th) * np.cos(ph), np.sin(th) * np.sin(ph), np.cos(th)], -1),
-                np.stack([np.cos(th) * np.cos(ph), np.cos(th) * np.sin(ph), -np.sin(th)], -1),
-                np.stack([-np.sin(ph), np.cos(ph), zero], -1),
-            ]
-        return np.stack(rows, axis=-2) @ self.rotation
-
-    def vector_to_basic(self, vector: np.ndarray, at: np.ndarray) -> np.ndarray:
-        """Basic components of a vector given by its components along the axes at ``at``."""
-        return np.asarray(vector, float) @ self.axes_at(at)
-
-
-#: the basic (station) frame
-BASIC = CoordinateFrame("basic", "rectangular", np.zeros(3), np.eye(3))
-
-
-def frame_from_points(
-    name: str, kind: str, a: np.ndarray, b: np.ndarray, c: np.ndarray, *, where: str
-) -> CoordinateFrame:
-    """The frame with origin ``a``, z axis towards ``b`` and ``c`` in the x-z plane (CORD2x).
-
-    Points in the basic frame, m.  Coincident or collinear points are an :class:`InputError`.
-    """
-    a, b, c = (np.asarray(v, float) for v in (a, b, c))
-    ez = b - a
-    nz = float(np.linalg.norm(ez))
-    scale = max(float(np.max(np.abs(np.concatenate([a, b, c])))), nz, 1e-300)
-    if nz <= 1e-12 * scale:
-        raise InputError("points A and B coincide", where=where, fix="give B off the origin A")
-    ez = ez / nz
-    ex = (c - a) - float(np.dot(c - a, ez)) * ez
-    nx = float(np.linalg.norm(ex))
-    if nx <= 1e-9 * max(float(np.linalg.norm(c - a)), 1e-300) or nx <= 1e-12 * scale:
-        raise InputError(
-            "point C lies on the z axis A-B", where=where, fix="give C off the line through A, B"
-        )
-    ex = ex / nx
-    ey = np.cross(ez, ex)
-    return CoordinateFrame(name, kind, a, np.stack([ex, ey, ez]))
 
 
 # --------------------------------------------------------------------------- items

@@ -36,6 +36,14 @@ from typing import Any
 import numpy as np
 
 from microg.errors import InputError
+from microg.models.bdf import grid_geometry
+from microg.models.coords import (
+    NASTRAN_KINDS,
+    CoordinateFrame,
+    Cord2,
+    chain_cord2,
+    nastran_coordinates,
+)
 from microg.models.modal import (
     ModalModel,
     ModalPoint,
@@ -45,7 +53,6 @@ from microg.models.modal import (
 )
 
 __all__ = [
-    "CoordSystem",
     "Op2File",
     "Op2Modes",
     "Op4Model",
@@ -195,127 +202,6 @@ class Op2File:
         return [t for t in self.tables if t[0] in names]
 
 
-# --------------------------------------------------------------------------- coordinates
-
-
-@dataclass(frozen=True)
-class CoordSystem:
-    """A NASTRAN coordinate system in the basic frame.
-
-    Attributes
-    ----------
-    cid : int
-    kind : str
-        ``"R"``, ``"C"`` or ``"S"``.
-    origin : ndarray (3,)
-        Basic coordinates of the origin.
-    axes : ndarray (3, 3)
-        Columns: the system's x, y, z unit vectors in basic.
-    """
-
-    cid: int
-    kind: str
-    origin: np.ndarray
-    axes: np.ndarray
-
-    def to_basic(self, x: np.ndarray) -> np.ndarray:
-        """Basic positions (n, 3) of coordinates ``x`` (n, 3) given in this system.
-
-        R: x, y, z; C: r, theta deg, z; S: r, theta deg, phi deg.
-        """
-        return self.origin + _local_rect(self.kind, np.asarray(x, float)) @ self.axes.T
-
-    def directions(self, xyz_basic: np.ndarray) -> np.ndarray:
-        """Output directions (n, 3, 3) at basic points.
-
-        Columns are the unit vectors of the system's components (x, y, z; r, theta, z;
-        r, theta, phi) in basic.
-        """
-        p = (np.asarray(xyz_basic, float) - self.origin) @ self.axes  # local rectangular
-        n = p.shape[0]
-        if self.kind == "R":
-            local = np.broadcast_to(np.eye(3), (n, 3, 3))
-        elif self.kind == "C":
-            th = np.arctan2(p[:, 1], p[:, 0])
-            c, s = np.cos(th), np.sin(th)
-            z, o = np.zeros(n), np.ones(n)
-            local = np.stack(
-                [np.stack([c, s, z], -1), np.stack([-s, c, z], -1), np.stack([z, z, o], -1)], -1
-            )
-        else:
-            r_xy = np.hypot(p[:, 0], p[:, 1])
-            th = np.arctan2(r_xy, p[:, 2])
-            ph = np.arctan2(p[:, 1], p[:, 0])
-            st, ct, sp, cp = np.sin(th), np.cos(th), np.sin(ph), np.cos(ph)
-            z = np.zeros(n)
-            local = np.stack(
-                [
-                    np.stack([st * cp, st * sp, ct], -1),
-                    np.stack([ct * cp, ct * sp, -st], -1),
-                    np.stack([-sp, cp, z], -1),
-                ],
-                -1,
-            )
-        return np.einsum("ab,nbc->nac", self.axes, local)
-
-
-def _local_rect(kind: str, x: np.ndarray) -> np.ndarray:
-    if kind == "R":
-        return x
-    if kind == "C":
-        r, th = x[..., 0], np.radians(x[..., 1])
-        return np.stack([r * np.cos(th), r * np.sin(th), x[..., 2]], -1)
-    r, th, ph = x[..., 0], np.radians(x[..., 1]), np.radians(x[..., 2])
-    return np.stack([r * np.sin(th) * np.cos(ph), r * np.sin(th) * np.sin(ph), r * np.cos(th)], -1)
-
-
-BASIC = CoordSystem(0, "R", np.zeros(3), np.eye(3))
-
-
-def cord2_system(
-    cid: int, kind: str, a: np.ndarray, b: np.ndarray, c: np.ndarray, ref: CoordSystem
-) -> CoordSystem:
-    """A CORD2R/C/S system from its points A (origin), B (on z), C (in the xz plane).
-
-    The points are given in the reference system ``ref``.
-    """
-    pa, pb, pc = ref.to_basic(np.array([a, b, c], float))
-    ez = pb - pa
-    if np.linalg.norm(ez) == 0:
-        raise ValueError(f"CORD2{kind} {cid}: points A and B coincide")
-    ez = ez / np.linalg.norm(ez)
-    ey = np.cross(ez, pc - pa)
-    if np.linalg.norm(ey) == 0:
-        raise ValueError(f"CORD2{kind} {cid}: point C is on the z axis")
-    ey = ey / np.linalg.norm(ey)
-    ex = np.cross(ey, ez)
-    return CoordSystem(cid, kind, pa, np.column_stack([ex, ey, ez]))
-
-
-def resolve_cord2(
-    cards: Sequence[tuple[int, str, int, np.ndarray]], where: str
-) -> dict[int, CoordSystem]:
-    """Chain CORD2 cards ``(cid, kind, rid, [A, B, C] (9,))`` to basic."""
-    systems: dict[int, CoordSystem] = {0: BASIC}
-    pending = {int(cid): (kind, int(rid), np.asarray(v, float)) for cid, kind, rid, v in cards}
-    while pending:
-        done = [cid for cid, (_, rid, _) in pending.items() if rid in systems]
-        if not done:
-            cid = sorted(pending)[0]
-            raise InputError(
-                f"coordinate system {cid} refers to system {pending[cid][1]}, which is not "
-                "defined (or the references loop)",
-                where=where,
-            )
-        for cid in done:
-            kind, rid, v = pending.pop(cid)
-            try:
-                systems[cid] = cord2_system(cid, kind, v[:3], v[3:6], v[6:9], systems[rid])
-            except ValueError as exc:
-                raise InputError(str(exc), where=where) from None
-    return systems
-
-
 # --------------------------------------------------------------------------- OP2 tables
 
 
@@ -343,7 +229,8 @@ class Op2Modes:
         Output system of each grid's components (0 when the table is in basic).
     xyz_basic : ndarray (g, 3) or None
         Grid positions in basic (file length unit).
-    coords : dict of int to CoordSystem
+    coords : dict of int to CoordinateFrame
+        Coordinate systems by id, origins in the file's length unit.
     rigid_mass : ndarray (6, 6) or None
         OGPWG's MO about ``rigid_mass_ref`` (input mass units: multiply by WTMASS).
     rigid_mass_ref : ndarray (3,) or None
@@ -364,7 +251,7 @@ class Op2Modes:
     shapes: np.ndarray
     cd: np.ndarray
     xyz_basic: np.ndarray | None
-    coords: dict[int, CoordSystem] = field(default_factory=dict)
+    coords: dict[int, CoordinateFrame] = field(default_factory=dict)
     rigid_mass: np.ndarray | None = None
     rigid_mass_ref: np.ndarray | None = None
     params: dict[str, Any] = field(default_factory=dict)
@@ -393,7 +280,7 @@ class Op2Modes:
                 )
             if self.xyz_basic is None:
                 raise InputError("no grid geometry to rotate output systems", where=self.path)
-            t = cs.directions(self.xyz_basic[sel])  # (n, 3, 3)
+            t = np.swapaxes(cs.axes_at(self.xyz_basic[sel]), -1, -2)  # columns: axes
             out[sel, :3] = np.einsum("nab,nbm->nam", t, out[sel, :3])
             out[sel, 3:] = np.einsum("nab,nbm->nam", t, out[sel, 3:])
         return out
@@ -459,12 +346,13 @@ def _lama(f: Op2File) -> np.ndarray | None:
     return None
 
 
-def _geometry(f: Op2File) -> tuple[dict[int, tuple[int, np.ndarray, int]], dict[int, CoordSystem]]:
+def _geometry(
+    f: Op2File,
+) -> tuple[dict[int, tuple[int, np.ndarray, int]], dict[int, CoordinateFrame]]:
     """Grid id -> (cp, x in cp, cd) and the coordinate systems, from GEOM1/GEOM1S."""
     grids: dict[int, tuple[int, np.ndarray, int]] = {}
-    cords: dict[int, tuple[int, str, int, np.ndarray]] = {}
+    cords: dict[int, Cord2] = {}
     kinds = {(2101, 21, 8): "R", (2001, 20, 9): "C", (2201, 22, 10): "S"}
-    w = f.word
     for _, _, recs in f.named("GEOM1", "GEOM1S"):
         for rec in recs[1:]:
             ints = f.ints(rec)
@@ -484,8 +372,16 @@ def _geometry(f: Op2File) -> tuple[dict[int, tuple[int, np.ndarray, int]], dict[
                 bi, bf = body_i[: 13 * n].reshape(n, 13), body_f[: 13 * n].reshape(n, 13)
                 for r in range(n):
                     cid = int(bi[r, 0])
+                    letter = kinds[head]
                     cords.setdefault(
-                        cid, (cid, kinds[head], int(bi[r, 3]), bf[r, 4:13].astype(float))
+                        cid,
+                        Cord2(
+                            cid,
+                            NASTRAN_KINDS[letter],
+                            int(bi[r, 3]),
+                            bf[r, 4:13].astype(float).reshape(3, 3),
+                            f"{f.path}: CORD2{letter} {cid}",
+                        ),
                     )
             elif head[:2] in ((1701, 17), (1801, 18), (1901, 19)):
                 raise InputError(
@@ -493,8 +389,7 @@ def _geometry(f: Op2File) -> tuple[dict[int, tuple[int, np.ndarray, int]], dict[
                     where=f.path,
                     fix="use CORD2R/C/S, or output in basic (PARAM,OUGCORD,BASIC)",
                 )
-    del w
-    systems = resolve_cord2(list(cords.values()), f.path)
+    systems = chain_cord2(list(cords.values()))
     return grids, systems
 
 
@@ -662,7 +557,7 @@ def read_op2_modes(path: str | Path) -> Op2Modes:
                     f"grids refer to coordinate system {cp}, not defined in the OP2", where=f.path
                 )
             m = cps == cp
-            xyz[m] = cs.to_basic(local[m])
+            xyz[m] = cs.to_basic(nastran_coordinates(cs.kind, local[m]))
     else:
         bg = _bgpdt(f)
         if bg and all(int(g) in bg for g in ids):
@@ -697,43 +592,6 @@ def read_op2_modes(path: str | Path) -> Op2Modes:
         params=params,
         n_scalar=n_scalar,
     )
-
-
-def _bdf_geometry(
-    bdf: str | Path, ids: np.ndarray
-) -> tuple[np.ndarray, np.ndarray, dict[int, CoordSystem]]:
-    """Grid positions (basic), output systems and coordinate systems from a BDF deck.
-
-    Uses microg's own deck reader (:mod:`microg.models.bdf`) when it offers
-    ``grid_geometry``; otherwise pyNastran, if installed.
-    """
-    try:
-        from microg.models import bdf as mbdf  # the deck reader (another module's)
-
-        geom = getattr(mbdf, "grid_geometry", None)
-    except ImportError:
-        geom = None
-    if geom is not None:
-        xyz, cd, systems = geom(bdf, ids)
-        return np.asarray(xyz, float), np.asarray(cd, int), dict(systems)
-    try:
-        from pyNastran.bdf.bdf import read_bdf
-    except ImportError:
-        raise InputError(
-            "the OP2 has no geometry tables and no BDF reader is available",
-            where=str(bdf),
-            fix=f"{EXTRA_HINT}, or rerun NASTRAN with the geometry in the OP2 (PARAM,POST)",
-        ) from None
-    model = read_bdf(str(bdf), debug=None)
-    systems = {}
-    for cid, c in model.coords.items():
-        kind = c.Type
-        systems[int(cid)] = CoordSystem(
-            int(cid), kind, np.asarray(c.origin, float), np.asarray(c.beta(), float).T
-        )
-    xyz = np.array([model.nodes[int(g)].get_position() for g in ids])
-    cd = np.array([model.nodes[int(g)].cd for g in ids])
-    return xyz, cd, systems
 
 
 def modal_model_from_op2(
@@ -790,7 +648,7 @@ def modal_model_from_op2(
                 where=where,
                 fix="rerun with PARAM,POST,-1/-2 (geometry written), or put the deck beside it",
             )
-        xyz, cd_bdf, coords = _bdf_geometry(deck, op2.grid_ids)
+        xyz, cd_bdf, coords = grid_geometry(deck, op2.grid_ids)
         if not op2.table.startswith("B") and str(op2.params.get("OUGCORD", "")).upper() != "BASIC":
             cd = cd_bdf
     data = Op2Modes(**{**op2.__dict__, "xyz_basic": xyz, "cd": cd, "coords": coords})
