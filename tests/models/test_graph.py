@@ -231,7 +231,24 @@ def test_dump_and_reload_reproduce_the_model():
         ),
         (('axes = "basic"\n', ""), "spring[0]", "coordinate system"),
         (("xy = 0.1", "xy = 3"), "payload", "positive semidefinite"),
-        (('mass = "consistent"', 'mass = "diagonal"'), "graph.mass", "lumped or consistent"),
+        (('mass = "consistent"', 'mass = "diagonal"'), "graph.mass", "'lumped' or 'consistent'"),
+        # the structure (pydantic, as for station files): tables, kinds of value, counts
+        (("[[rod]]", "[[bogus]]\n[[rod]]"), "frame.toml: bogus", "unknown key"),
+        (('nodes = ["c", "a"]', 'nodes = ["c"]'), "rod[0].nodes", "expected two node names"),
+        (('dependents = ["a2"]', "dependents = []"), "rigid[0].dependents", "non-empty array"),
+        (
+            ('axes = "basic"', "axes = [[1, 0, 0], [0, 1, 0], [0, 0, 2]]"),
+            "spring[0].axes",
+            "orthonormal",
+        ),
+        (("damping = { z", "damping = { q"), "spring[0].damping.q", "allowed keys here: x, y"),
+        (('kind = "crew"', 'kind = "pilot"'), "point[0].kind", "'crew', 'experiment' or 'point'"),
+        (("at = [2, 2.2, 0]", "at = [2, 2.2]"), "point[0].at", "three lengths"),
+        (
+            ("rotary_inertia = true", 'rotary_inertia = "yes"'),
+            "section[0].rotary_inertia",
+            "true or false",
+        ),
     ],
 )
 def test_bad_graph_files_are_one_line_errors(edit, where, what):
@@ -246,7 +263,7 @@ def test_bad_graph_files_are_one_line_errors(edit, where, what):
 def test_syntax_error_and_missing_file(tmp_path):
     with pytest.raises(ModelError, match="invalid TOML"):
         loads_graph("[graph\nname=1", filename="x.toml")
-    with pytest.raises(ModelError, match=r"missing \[graph\]"):
+    with pytest.raises(ModelError, match=r"x.toml: graph: required table is missing \(add it"):
         loads_graph("[[node]]\nname='a'\nat=[0,0,0]\n", filename="x.toml")
     with pytest.raises(InputError, match="cannot read"):
         load_graph(tmp_path / "none.toml")

@@ -55,7 +55,8 @@ from microg.models.coords import (
     chain_cord2,
     nastran_coordinates,
 )
-from microg.models.graph import (
+from microg.models.graph_check import validate_graph
+from microg.models.graph_model import (
     BeamElement,
     BeamSection,
     ConcentratedMass,
@@ -70,7 +71,6 @@ from microg.models.graph import (
     Spring,
     parse_components,
     spring_axes,
-    validate_graph,
 )
 from microg.models.modal import ModalPoint, UnitSystem, parse_units
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import types
 import typing
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 from pydantic import BaseModel, ValidationError
@@ -138,7 +138,12 @@ def _model_at(root: type[BaseModel], loc: Sequence[str | int]) -> type[BaseModel
     return model
 
 
-def structure_error(exc: ValidationError, file: str, root: type[BaseModel]) -> ModelError:
+def structure_error(
+    exc: ValidationError,
+    file: str,
+    root: type[BaseModel],
+    examples: Mapping[str, str] = EXAMPLES,
+) -> ModelError:
     """The first error of a pydantic ValidationError as a one-line ModelError.
 
     Parameters
@@ -146,6 +151,7 @@ def structure_error(exc: ValidationError, file: str, root: type[BaseModel]) -> M
     exc : the validation error of ``root.model_validate``
     file : the file's name for the message
     root : the schema's root model (to list the keys allowed where a key is unknown)
+    examples : example values by key, for "add it" hints (default: the station format's)
     """
     errors = exc.errors(include_url=False)
     # a misspelt key also makes the right one "missing": report the misspelling
@@ -156,13 +162,10 @@ def structure_error(exc: ValidationError, file: str, root: type[BaseModel]) -> M
     kind = err["type"]
     key = loc[-1] if loc else ""
     if kind == "missing":
-        example = EXAMPLES.get(str(key))
+        example = examples.get(str(key))
         fix = f"add it, e.g. {example}" if example else "add it"
-        what = (
-            "required table is missing"
-            if key in ("station", "orbit")
-            else "required key is missing"
-        )
+        table = isinstance(key, str) and _model_at(root, loc) is not None
+        what = "required table is missing" if table else "required key is missing"
         if key == "body":
             what = "the model has no [[body]]: it needs at least the root body"
         return ModelError(what, where=where, fix=fix)
@@ -176,6 +179,13 @@ def structure_error(exc: ValidationError, file: str, root: type[BaseModel]) -> M
             "the model has no [[body]]: it needs at least the root body",
             where=where,
             fix=f"add {EXAMPLES['body']}",
+        )
+    if kind == "too_short":
+        example = examples.get(str(key))
+        return ModelError(
+            "expected a non-empty array",
+            where=where,
+            fix=f"give at least one, e.g. {example}" if example else "give at least one",
         )
     if kind == "too_long":
         limit = (err.get("ctx") or {}).get("max_length")

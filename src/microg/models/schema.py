@@ -44,6 +44,13 @@ __all__ = [
     "OrbitIn",
     "PointIn",
     "StationIn",
+    "Direction",
+    "Name",
+    "Position",
+    "Quantity",
+    "Range",
+    "TableIn",
+    "Text",
 ]
 
 #: Earth's equatorial radius (WGS 84), m: ``[orbit] altitude`` is measured from it, and an
@@ -229,115 +236,123 @@ def _range_input(value: Any) -> list[str | float]:
     return [_quantity_input(c) for c in value]
 
 
-_Q = Annotated[str | float, PlainValidator(_quantity_input)]
-_Vec = Annotated[list[str | float], PlainValidator(_vector_input)]
-_Range = Annotated[list[str | float], PlainValidator(_range_input)]
-_Dir = Annotated[tuple[float, float, float], PlainValidator(_direction_input)]
-_Name = Annotated[StrictStr, Field(min_length=1, max_length=MAX_NAME)]
-_Text = Annotated[StrictStr, Field(max_length=MAX_TEXT)]
+#: a quantity as written (a string with a unit, or a finite number)
+Quantity = Annotated[str | float, PlainValidator(_quantity_input)]
+#: a position [x, y, z] of three quantities
+Position = Annotated[list[str | float], PlainValidator(_vector_input)]
+#: a range [lo, hi] of two quantities
+Range = Annotated[list[str | float], PlainValidator(_range_input)]
+#: a unit direction (an axis name or three numbers)
+Direction = Annotated[tuple[float, float, float], PlainValidator(_direction_input)]
+#: a name: a non-empty string of at most MAX_NAME characters
+Name = Annotated[StrictStr, Field(min_length=1, max_length=MAX_NAME)]
+#: free text of at most MAX_TEXT characters
+Text = Annotated[StrictStr, Field(max_length=MAX_TEXT)]
 
 
 # ----------------------------------------------------------------------------------- tables
 
 
-class _In(BaseModel):
+class TableIn(BaseModel):
+    """A table of a model file: unknown keys refused, values frozen."""
+
     model_config = ConfigDict(extra="forbid", frozen=True)
 
 
-class StationIn(_In):
+class StationIn(TableIn):
     """``[station]``."""
 
-    name: _Name
-    description: _Text = ""
+    name: Name
+    description: Text = ""
     units: Literal["SI", "US"] | None = None
-    weight_gravity: _Q | None = None
-    reference_length: _Q | None = None
+    weight_gravity: Quantity | None = None
+    reference_length: Quantity | None = None
 
 
-class OrbitIn(_In):
+class OrbitIn(TableIn):
     """``[orbit]``."""
 
-    radius: _Q | None = None
-    altitude: _Q | None = None
-    mu: _Q | None = None
+    radius: Quantity | None = None
+    altitude: Quantity | None = None
+    mu: Quantity | None = None
 
 
-class InertiaIn(_In):
+class InertiaIn(TableIn):
     """An ``inertia = { xx = ..., ... }`` inline table."""
 
-    xx: _Q | None = None
-    yy: _Q | None = None
-    zz: _Q | None = None
-    xy: _Q | None = None
-    xz: _Q | None = None
-    yz: _Q | None = None
+    xx: Quantity | None = None
+    yy: Quantity | None = None
+    zz: Quantity | None = None
+    xy: Quantity | None = None
+    xz: Quantity | None = None
+    yz: Quantity | None = None
 
 
-class MassIn(_In):
+class MassIn(TableIn):
     """The keys common to body and beam point masses."""
 
-    name: _Name
-    mass: _Q | None = None
-    weight: _Q | None = None
+    name: Name
+    mass: Quantity | None = None
+    weight: Quantity | None = None
     inertia: InertiaIn | None = None
-    source: _Text = ""
+    source: Text = ""
     fitted: StrictBool = False
-    movable: _Range | None = None
+    movable: Range | None = None
 
 
 class BodyMassIn(MassIn):
     """``[[body.mass]]``."""
 
-    at: _Vec
+    at: Position
 
 
 class BeamMassIn(MassIn):
     """``[[beam.mass]]``."""
 
-    s: _Q | None = None
-    at: _Vec | None = None
+    s: Quantity | None = None
+    at: Position | None = None
 
 
-class BodyIn(_In):
+class BodyIn(TableIn):
     """``[[body]]``."""
 
-    name: _Name
-    parent: _Name | None = None
-    at: _Vec | None = None
+    name: Name
+    parent: Name | None = None
+    at: Position | None = None
     mass: Annotated[list[BodyMassIn], Field(max_length=MAX_COUNTS["mass"])] = []
 
 
-class BeamIn(_In):
+class BeamIn(TableIn):
     """``[[beam]]``."""
 
-    name: _Name
-    parent: _Name
-    root: _Vec
-    direction: _Dir
-    length: _Q
-    orientation: _Dir | None = None
-    ei: _Q | None = None
-    ei_y: _Q | None = None
-    ei_z: _Q | None = None
-    gj: _Q
-    ea: _Q | None = None
-    mass_per_length: _Q | None = None
-    weight_per_length: _Q | None = None
+    name: Name
+    parent: Name
+    root: Position
+    direction: Direction
+    length: Quantity
+    orientation: Direction | None = None
+    ei: Quantity | None = None
+    ei_y: Quantity | None = None
+    ei_z: Quantity | None = None
+    gj: Quantity
+    ea: Quantity | None = None
+    mass_per_length: Quantity | None = None
+    weight_per_length: Quantity | None = None
     mass: Annotated[list[BeamMassIn], Field(max_length=MAX_COUNTS["mass"])] = []
 
 
-class PointIn(_In):
+class PointIn(TableIn):
     """``[[point]]``."""
 
-    name: _Name
-    on: _Name
-    at: _Vec | None = None
-    s: _Q | None = None
+    name: Name
+    on: Name
+    at: Position | None = None
+    s: Quantity | None = None
     kind: Literal["crew", "experiment", "point"] = "point"
-    description: _Text = ""
+    description: Text = ""
 
 
-class FileIn(_In):
+class FileIn(TableIn):
     """A whole model file."""
 
     station: StationIn

@@ -84,7 +84,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from microg.errors import InputError
-from microg.models.graph import ConcentratedMass
+from microg.models.graph_model import ConcentratedMass
 from microg.models.station import POLAR_GYRATION_FRACTION, Station
 from microg.structure.frame import (
     AXIAL_PENALTY,

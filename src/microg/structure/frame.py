@@ -74,7 +74,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from microg.errors import InputError
-from microg.models.graph import (
+from microg.models.graph_check import validate_graph
+from microg.models.graph_model import (
     BeamElement,
     BeamSection,
     ConcentratedMass,
@@ -82,7 +83,6 @@ from microg.models.graph import (
     GraphPoint,
     Node,
     Spring,
-    validate_graph,
 )
 from microg.models.station import Beam, RigidBody, Station
 from microg.structure.structure import PointMap, Structure
