@@ -7,7 +7,6 @@ environment, pyNastran's parse of the same decks.
 
 from __future__ import annotations
 
-import importlib.util
 import math
 from pathlib import Path
 
@@ -15,7 +14,8 @@ import numpy as np
 import pytest
 
 from microg.errors import InputError
-from microg.models.bdf import _value, load_bdf, read_cards
+from microg.models.bdf import load_bdf, read_cards
+from microg.models.bdf_cards import _value
 from microg.structure.frame import assemble_frame, build_frame
 from microg.units import IN, LBF
 
@@ -390,9 +390,7 @@ def test_cbush_without_needed_orientation(tmp_path):
 
 def test_cli_exit_status_two_for_a_bad_deck(tmp_path, capsys):
     # microg modes DECK: a bad deck is one line on stderr and exit status 2 (the CLI maps the
-    # library's InputError); needs the model loader to dispatch .bdf decks (models/load.py)
-    if importlib.util.find_spec("microg.models.load") is None:
-        pytest.skip("microg.models.load (the loader that dispatches .bdf) is not in the tree yet")
+    # library's InputError)
     from microg.cli import main
 
     deck = _deck(tmp_path, BASE + "CQUAD4,5,20,1,2,2,1\n")

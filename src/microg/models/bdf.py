@@ -1,17 +1,14 @@
-"""NASTRAN bulk data (BDF/DAT) import: a deck becomes a :class:`~microg.models.graph.GraphModel`.
+"""NASTRAN bulk data (BDF/DAT) import: a deck's cards become a graph model.
 
 ``load_bdf(path, units="in, lbf, s")`` reads a deck with microg's own card reader (no
 pyNastran: its 1.4 releases pin numpy < 2, and the bulk data format is small and documented)
 and converts it to SI at the boundary.  The reader is checked against pyNastran's parse of
 the same decks in the ``nastran`` extra's environment (``tests/models/test_bdf.py``).
 
-**Format read.** Executive and case control up to ``BEGIN BULK`` (the case control's
-``SPC = n`` is noted), then bulk data to ``ENDDATA``: small-field (8 columns), large-field
-(``NAME*``, 16 columns, ``*`` continuations) and free-field (commas) entries; continuation
-lines (``+``/``*`` in column 1, or a blank first field); ``$`` comments; tabs as 8-column
-stops; ``INCLUDE 'file'`` anywhere (relative to the including file, nested to
-:data:`MAX_INCLUDE_DEPTH`).  Real numbers in NASTRAN's forms (``1.5``, ``1.5E-3``,
-``1.5-3``, ``1.5D-3``, ``.5``).
+**Format read** by :mod:`microg.models.bdf_cards` (small-, large- and free-field entries,
+continuations, ``INCLUDE``); the case control's ``SPC = n`` is noted.  This module turns
+the cards into the graph; :mod:`microg.models.bdf_properties` reads the property and
+material cards.
 
 **Cards converted:** GRID (CP, CD), CORD2R/C/S, CBAR, CBEAM, BAROR, BEAMOR, PBAR, PBARL,
 PBEAM (uniform), PBEAML (uniform), CROD, PROD, CONROD, CBUSH + PBUSH (K, B, GE), CELAS1 +
@@ -25,13 +22,14 @@ each unsupported card with its count.  Nothing is dropped silently.
 
 **Units.**  NASTRAN decks declare none: ``units="LENGTH, FORCE, TIME"`` is required (e.g.
 ``"in, lbf, s"``, ``"mm, N, s"``, ``"m, N, s"``; :func:`microg.models.modal.parse_units`);
-the mass unit is FORCE TIME^2 / LENGTH.  Mass
-input (densities, non-structural mass, CONM2) is multiplied by WTMASS (``PARAM,WTMASS``, or
-the ``wtmass`` argument; both given and different is an error).
+the mass unit is FORCE TIME^2 / LENGTH.  Mass input (densities, non-structural mass, CONM2)
+is multiplied by WTMASS (``PARAM,WTMASS``, or the ``wtmass`` argument; both given and
+different is an error).
 
 **Element formulation** follows NASTRAN: lumped mass unless ``PARAM,COUPMASS`` > 0; shear
 flexibility from PBAR/PBEAM K1, K2 (PBAR blank: none; PBEAM default 1.0; 0.0: none) and from
-the PBARL/PBEAML section (:data:`SECTION_SHEAR_FACTORS`); see :mod:`microg.structure.frame`.
+the PBARL/PBEAML section (:data:`~microg.models.bdf_properties.SECTION_SHEAR_FACTORS`);
+see :mod:`microg.structure.frame`.
 """
 
 from __future__ import annotations
@@ -40,14 +38,26 @@ import dataclasses
 import math
 import re
 from collections import Counter
-from collections.abc import Iterator, Sequence
-from dataclasses import dataclass
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from microg.errors import InputError
+from microg.models.bdf_cards import MAX_CARDS, MAX_INCLUDE_DEPTH, Card, read_cards
+from microg.models.bdf_properties import (
+    SECTION_SHEAR_FACTORS,
+    BeamProperty,
+    Material,
+    Scales,
+    beam_properties,
+    beam_section,
+    bush_properties,
+    material,
+    materials,
+    scalar_spring_properties,
+)
 from microg.models.coords import (
     NASTRAN_KINDS,
     CoordinateFrame,
@@ -107,351 +117,9 @@ IGNORED_CARDS = (
     "SUPORT1", "MONPNT1", "DTI",
 )
 # fmt: on
-#: the deepest nesting of INCLUDE files
-MAX_INCLUDE_DEPTH = 20
-#: the most cards read from one deck (documented limit)
-MAX_CARDS = 5_000_000
-#: transverse shear factors (K1, K2) NASTRAN gives PBARL/PBEAML sections.  ROD's 0.9 is
-#: the value Simcenter Nastran prints for the beam_modes fixture (IFP9A echo); the others
-#: are the textbook factors (thin tube 1/2, rectangle 5/6), not checked against NASTRAN
-SECTION_SHEAR_FACTORS = {"ROD": 0.9, "TUBE": 0.5, "TUBE2": 0.5, "BAR": 5.0 / 6.0}
-#: dimensions per PBARL/PBEAML type supported
-_SECTION_DIMS = {"ROD": 1, "TUBE": 2, "TUBE2": 2, "BAR": 2}
-_STRESS_SO = ("YES", "YESA", "NO")
-
-
-# --------------------------------------------------------------------------- cards
-
-
-@dataclass(frozen=True)
-class Card:
-    """One bulk data entry: its name and fields, where it was read.
-
-    ``fields[0]`` is the name; ``fields[i]`` the i-th data field counting across
-    continuations (8 per small-field line), pyNastran's numbering.  Each field is an int,
-    a float, an upper-case str or None (blank).
-    """
-
-    fields: tuple[Any, ...]
-    file: str
-    line: int
-
-    @property
-    def name(self) -> str:
-        """Card name, upper case (``GRID``)."""
-        return str(self.fields[0])
-
-    def __len__(self) -> int:
-        return len(self.fields)
-
-    def raw(self, i: int) -> Any:
-        """Field ``i`` or None beyond the end."""
-        return self.fields[i] if i < len(self.fields) else None
-
-    @property
-    def where(self) -> str:
-        """``FILE:LINE: NAME ID`` of the card, for error messages."""
-        ident = self.raw(1)
-        return f"{self.file}:{self.line}: {self.name}" + (f" {ident}" if ident is not None else "")
-
-    def error(self, what: str, fix: str | None = None) -> InputError:
-        """An :class:`~microg.errors.InputError` at this card (:attr:`where`)."""
-        return InputError(what, where=self.where, fix=fix)
-
-    def integer(self, i: int, label: str, default: Any = ...) -> int:
-        """Integer field ``i`` (``label`` in messages); blank: ``default`` or an error."""
-        v = self.raw(i)
-        if v is None:
-            if default is ...:
-                raise self.error(f"field {i + 1} ({label}) is blank", f"give {label}")
-            return default
-        if not isinstance(v, int):
-            raise self.error(f"field {i + 1} ({label}) must be an integer, got {v!r}")
-        return v
-
-    def real(self, i: int, label: str, default: Any = ...) -> float:
-        """Real field ``i`` as written (an integer is accepted); blank: ``default`` or an error."""
-        v = self.raw(i)
-        if v is None:
-            if default is ...:
-                raise self.error(f"field {i + 1} ({label}) is blank", f"give {label}")
-            return default
-        if isinstance(v, str):
-            raise self.error(f"field {i + 1} ({label}) must be a number, got {v!r}")
-        return float(v)
-
-    def text(self, i: int, label: str, default: Any = ...) -> str:
-        """Field ``i`` as text (``label`` in messages); blank: ``default`` or an error."""
-        v = self.raw(i)
-        if v is None:
-            if default is ...:
-                raise self.error(f"field {i + 1} ({label}) is blank", f"give {label}")
-            return default
-        return str(v)
-
-
-_INT = re.compile(r"[+-]?\d+$")
-_REAL = re.compile(r"([+-]?(?:\d+\.\d*|\.\d+|\d+))(?:([EeDd])?([+-]?\d+))?$")
-
-
-def _value(text: str) -> Any:
-    """A field's value: None, int, float or an upper-case string."""
-    s = text.strip()
-    if not s:
-        return None
-    if _INT.match(s):
-        return int(s)
-    m = _REAL.match(s)
-    if m and ("." in m.group(1) or m.group(2)):
-        mant, letter, exp = m.group(1), m.group(2), m.group(3)
-        if exp is not None and letter is None and not exp.startswith(("+", "-")):
-            return s.upper()  # "1.5 3" and the like: not a number
-        try:
-            v = float(mant) * 10.0 ** int(exp) if exp is not None else float(mant)
-        except OverflowError:
-            return s.upper()
-        return v if math.isfinite(v) else s.upper()
-    return s.upper()
-
-
-@dataclass
-class _Line:
-    text: str
-    file: str
-    number: int
-
-
-def _read_lines(path: Path, shown: str, depth: int, stack: tuple[Path, ...]) -> Iterator[_Line]:
-    """Lines of ``path`` with INCLUDEs expanded (file name and line number kept)."""
-    try:
-        raw = path.read_bytes()
-    except OSError as exc:
-        raise InputError(f"cannot read the file: {exc.strerror or exc}", where=shown) from None
-    text = raw.decode("latin-1")
-    lines = text.splitlines()
-    i = 0
-    while i < len(lines):
-        line = lines[i].expandtabs(8)
-        number = i + 1
-        i += 1
-        head = line.lstrip()[:7].upper()
-        if head == "INCLUDE" and not line.lstrip().startswith("$"):
-            spec = line.lstrip()[7:]
-            while spec.count("'") == 1 and i < len(lines):  # a quoted path continued
-                spec += lines[i].strip()
-                i += 1
-            m = re.match(r"\s*'([^']*)'\s*(\$.*)?$", spec) or re.match(r"\s*(\S+)\s*(\$.*)?$", spec)
-            if not m:
-                raise InputError(
-                    "INCLUDE needs a file name",
-                    where=f"{shown}:{number}",
-                    fix="write INCLUDE 'file.bdf'",
-                )
-            name = m.group(1).strip()
-            target = Path(name) if Path(name).is_absolute() else path.parent / name
-            target_shown = str(Path(shown).parent / name) if not Path(name).is_absolute() else name
-            if depth >= MAX_INCLUDE_DEPTH or target.resolve() in stack:
-                raise InputError(
-                    f"INCLUDE {name!r} nests deeper than {MAX_INCLUDE_DEPTH} or includes itself",
-                    where=f"{shown}:{number}",
-                    fix="remove the circular INCLUDE",
-                )
-            if not target.is_file():
-                raise InputError(
-                    f"INCLUDE {name!r}: file not found",
-                    where=f"{shown}:{number}",
-                    fix="give the path relative to the including file",
-                )
-            yield from _read_lines(target, target_shown, depth + 1, (*stack, target.resolve()))
-            continue
-        yield _Line(line, shown, number)
-
-
-def _free(parts: list[str], large: bool, where: str) -> list[str]:
-    """Data fields of a free-field line (after its first field): 8 (4 large), then a marker."""
-    per = 4 if large else 8
-    data = parts[1:]
-    if len(data) > per + 1 or (len(data) == per + 1 and isinstance(_value(data[per]), int | float)):
-        raise InputError(
-            f"a free-field line holds {per} data fields and a continuation marker, "
-            f"this one has {len(data)} fields",
-            where=where,
-            fix="continue the card on a new line starting with '+' (or ',')",
-        )
-    return data[:per]
-
-
-def _fields_of(line: str, where: str) -> tuple[str, list[str]]:
-    """(name, data fields) of the first line of a card."""
-    if "," in line:
-        parts = line.split(",")
-        head = parts[0].strip()
-        return head.rstrip("*"), _free(parts, head.endswith("*"), where)
-    head = line[:8]
-    if head.strip().endswith("*"):
-        data = [line[8 + 16 * k : 24 + 16 * k] for k in range(4)]
-    else:
-        data = [line[8 + 8 * k : 16 + 8 * k] for k in range(8)]
-    return head.strip().rstrip("*"), data
-
-
-def _is_continuation(line: str) -> bool:
-    s = line.rstrip()
-    if not s:
-        return False
-    if s[0] in "+*" or s.startswith(","):
-        return True
-    if "," in s:
-        return not s.split(",")[0].strip()
-    return not line[:8].strip()
-
-
-def read_cards(path: str | Path) -> tuple[list[Card], list[str]]:
-    """Bulk data cards of a deck and its case control lines.
-
-    Parameters
-    ----------
-    path : str or Path
-        The deck (``.bdf``, ``.dat``, ``.blk``, ``.nas``); INCLUDEs relative to it.
-
-    Returns
-    -------
-    cards : list of Card
-    case_control : list of str
-        Upper-case case control lines (empty for a bulk-only file).
-    """
-    p = Path(path)
-    shown = str(path)
-    if not p.is_file():
-        raise InputError("file not found", where=shown, fix="check the path")
-    lines = list(_read_lines(p, shown, 0, (p.resolve(),)))
-    begin = next(
-        (k for k, ln in enumerate(lines) if re.match(r"\s*BEGIN\s+(BULK|SUPER)", ln.text, re.I)),
-        None,
-    )
-    case: list[str] = []
-    if begin is not None:
-        if re.match(r"\s*BEGIN\s+SUPER", lines[begin].text, re.I):
-            raise InputError(
-                "superelement bulk data (BEGIN SUPER) is not supported",
-                where=f"{lines[begin].file}:{lines[begin].number}",
-                fix="give the residual structure only",
-            )
-        cend = next(
-            (k for k, ln in enumerate(lines[:begin]) if re.match(r"\s*CEND\b", ln.text, re.I)), -1
-        )
-        case = [ln.text.split("$")[0].strip().upper() for ln in lines[cend + 1 : begin]]
-        lines = lines[begin + 1 :]
-    cards: list[Card] = []
-    cur: list[Any] | None = None
-    cur_at: tuple[str, int] = ("", 0)
-    for ln in lines:
-        text = ln.text.split("$", 1)[0] if "$" in ln.text else ln.text
-        if not text.strip():
-            continue
-        if re.match(r"\s*ENDDATA\b", text, re.I):
-            break
-        where = f"{ln.file}:{ln.number}"
-        if cur is not None and _is_continuation(text):
-            if "," in text:
-                parts = text.split(",")
-                data = _free(parts, parts[0].strip().startswith("*"), where)
-            else:
-                large = text.startswith("*")
-                data = (
-                    [text[8 + 16 * k : 24 + 16 * k] for k in range(4)]
-                    if large
-                    else [text[8 + 8 * k : 16 + 8 * k] for k in range(8)]
-                )
-            cur.extend(_value(f) for f in data)
-            continue
-        if cur is not None:
-            cards.append(_card(cur, cur_at))
-        if len(cards) >= MAX_CARDS:
-            raise InputError(f"more than {MAX_CARDS} cards", where=shown, fix="split the model")
-        name, data = _fields_of(text, where)
-        cur = [name.strip().upper(), *(_value(f) for f in data)]
-        cur_at = (ln.file, ln.number)
-    if cur is not None:
-        cards.append(_card(cur, cur_at))
-    return cards, case
-
-
-def _card(fields: list[Any], at: tuple[str, int]) -> Card:
-    while len(fields) > 1 and fields[-1] is None:
-        fields.pop()
-    return Card(tuple(fields), at[0], at[1])
-
-
-# --------------------------------------------------------------------------- units
-
-
-@dataclass(frozen=True)
-class _Scales:
-    length: float
-    force: float
-    time: float
-
-    @property
-    def mass(self) -> float:
-        return self.force * self.time**2 / self.length
-
-
-# --------------------------------------------------------------------------- sections
-
-
-def _section_values(
-    kind: str, dims: list[float], card: Card
-) -> tuple[float, float, float, float, float]:
-    """A, I1, I2, J and the shear factor of a PBARL/PBEAML section (deck units)."""
-    if any(not d > 0 for d in dims):
-        raise card.error(f"section {kind} dimensions must be > 0, got {dims}")
-    k = SECTION_SHEAR_FACTORS[kind]
-    if kind == "ROD":
-        r = dims[0]
-        a = math.pi * r**2
-        i = math.pi * r**4 / 4.0
-        return a, i, i, 2.0 * i, k
-    if kind in ("TUBE", "TUBE2"):
-        ro = dims[0]
-        ri = dims[1] if kind == "TUBE" else dims[0] - dims[1]
-        if not 0 <= ri < ro:
-            raise card.error(f"{kind} needs an inner radius between 0 and the outer, got {dims}")
-        a = math.pi * (ro**2 - ri**2)
-        i = math.pi * (ro**4 - ri**4) / 4.0
-        return a, i, i, 2.0 * i, k
-    # BAR: DIM1 x DIM2, I1 = DIM1 DIM2^3 / 12 (pyNastran's convention), Roark's J
-    b, h = dims
-    long_, short = max(b, h), min(b, h)
-    j = long_ * short**3 * (1.0 / 3.0 - 0.21 * short / long_ * (1.0 - short**4 / (12.0 * long_**4)))
-    return b * h, b * h**3 / 12.0, h * b**3 / 12.0, j, k
 
 
 # --------------------------------------------------------------------------- deck -> graph
-
-
-@dataclass
-class _Material:
-    e: float
-    g: float
-    nu: float
-    rho: float
-    ge: float
-    card: Card
-
-
-@dataclass
-class _BeamProp:
-    a: float
-    i1: float
-    i2: float
-    i12: float
-    j: float
-    nsm: float
-    k1: float | None
-    k2: float | None
-    mid: int
-    card: Card
 
 
 class _Deck:
@@ -462,7 +130,7 @@ class _Deck:
         cards: list[Card],
         case: list[str],
         path: str,
-        sc: _Scales,
+        sc: Scales,
         wtmass: float | None,
         spc: int | None,
     ):
@@ -474,6 +142,9 @@ class _Deck:
         self.user_spc = spc
         self.warnings: list[str] = []
         self.origin: dict[str, Card] = {}
+        self.grid_cards: dict[int, Card] = {}
+        self.grid_ps: list[tuple[str, str]] = []
+        self.spc_sets: list[int] = []
 
     def by_id(self, names: tuple[str, ...], what: str) -> dict[int, Card]:
         out: dict[int, Card] = {}
@@ -519,8 +190,10 @@ class _Deck:
             )
         frames = self.frames()
         nodes, grid_pos, grid_axes = self.grids(frames)
-        mats = self.materials()
-        beam_props = self.beam_properties(mats)
+        mats = materials(self.by_id(("MAT1",), "material"), self.sc)
+        beam_props = beam_properties(
+            self.by_id(("PBAR", "PBARL", "PBEAM", "PBEAML"), "beam property"), self.warnings
+        )
         beams = self.beams(beam_props, mats, grid_pos, grid_axes, wt)
         rods = self.rods(mats, grid_pos, wt)
         springs = self.bushes(grid_pos, grid_axes, frames)
@@ -637,7 +310,7 @@ class _Deck:
         nodes: list[Node] = []
         pos: dict[int, np.ndarray] = {}
         axes: dict[int, np.ndarray] = {}
-        self.grid_ps: list[tuple[str, str]] = []
+        self.grid_ps = []
         for gid, c in sorted(grids.items()):
             cp = c.integer(2, "CP", 0)
             cd = c.integer(6, "CD", 0)
@@ -678,165 +351,6 @@ class _Deck:
             )
         return f"grid:{gid}"
 
-    # ---- materials and properties
-
-    def materials(self) -> dict[int, _Material]:
-        out: dict[int, _Material] = {}
-        sc = self.sc
-        for mid, c in self.by_id(("MAT1",), "material").items():
-            e = c.real(2, "E", None)
-            g = c.real(3, "G", None)
-            nu = c.real(4, "NU", None)
-            if not e and not g:
-                raise c.error("E and G are both blank or zero", "give E (and NU or G)")
-            if e and g is None:
-                g = e / (2.0 * (1.0 + nu)) if nu is not None else 0.0
-            elif g and e is None:
-                e = 2.0 * (1.0 + nu) * g if nu is not None else 0.0
-            if nu is None:
-                nu = e / (2.0 * g) - 1.0 if e and g else 0.0
-            rho = c.real(5, "RHO", 0.0)
-            ge = c.real(8, "GE", 0.0)
-            assert e is not None and g is not None
-            if e < 0 or g < 0 or rho < 0:
-                raise c.error("E, G and RHO must be >= 0")
-            out[mid] = _Material(
-                e * sc.force / sc.length**2, g * sc.force / sc.length**2, nu, rho, ge, c
-            )
-        return out
-
-    def material(self, mats: dict[int, _Material], mid: int, c: Card) -> _Material:
-        if mid not in mats:
-            raise c.error(
-                f"material {mid} (MAT1) is not defined", "add the MAT1 card or correct MID"
-            )
-        return mats[mid]
-
-    def beam_properties(self, mats: dict[int, _Material]) -> dict[int, _BeamProp]:
-        out: dict[int, _BeamProp] = {}
-        for pid, c in self.by_id(("PBAR", "PBARL", "PBEAM", "PBEAML"), "beam property").items():
-            mid = c.integer(2, "MID")
-            if c.name == "PBAR":
-                k1 = c.real(17, "K1", None)
-                k2 = c.real(18, "K2", None)
-                prop = _BeamProp(
-                    c.real(3, "A", 0.0),
-                    c.real(4, "I1", 0.0),
-                    c.real(5, "I2", 0.0),
-                    c.real(19, "I12", 0.0),
-                    c.real(6, "J", 0.0),
-                    c.real(7, "NSM", 0.0),
-                    k1 if k1 else None,
-                    k2 if k2 else None,
-                    mid,
-                    c,
-                )
-            elif c.name == "PBEAM":
-                prop = self.pbeam(c, mid)
-            else:
-                prop = self.pbarl(c, mid)
-            out[pid] = prop
-        return out
-
-    def pbarl(self, c: Card, mid: int) -> _BeamProp:
-        group = c.text(3, "GROUP", "MSCBML0")
-        kind = c.text(4, "TYPE")
-        if group != "MSCBML0":
-            raise c.error(f"section group {group!r} is not supported", "use the MSCBML0 library")
-        if kind not in _SECTION_DIMS:
-            raise c.error(
-                f"section type {kind!r} is not supported (microg knows {', '.join(_SECTION_DIMS)})",
-                "give the section as PBAR/PBEAM with A, I1, I2, J, K1, K2",
-            )
-        n = _SECTION_DIMS[kind]
-        dims = [c.real(9 + k, f"DIM{k + 1}") for k in range(n)]
-        nsm = c.real(9 + n, "NSM", 0.0)
-        if c.name == "PBEAML":
-            i = 10 + n
-            while i < len(c):  # further stations: SO, X/XB, dims, NSM; uniform only
-                sd = [c.real(i + 2 + k, f"DIM{k + 1}", dims[k]) for k in range(n)]
-                snsm = c.real(i + 2 + n, "NSM", nsm)
-                if not np.allclose(sd, dims, rtol=1e-9) or not math.isclose(
-                    snsm, nsm, rel_tol=1e-9
-                ):
-                    raise c.error(
-                        "tapered sections are not supported", "give a uniform section (one station)"
-                    )
-                i += 3 + n
-        elif len(c) > 10 + n:
-            raise c.error("has fields beyond DIMs and NSM")
-        a, i1, i2, j, k = _section_values(kind, dims, c)
-        return _BeamProp(a, i1, i2, 0.0, j, nsm, k, k, mid, c)
-
-    def pbeam(self, c: Card, mid: int) -> _BeamProp:
-        a = c.real(3, "A")
-        i1 = c.real(4, "I1", 0.0)
-        i2 = c.real(5, "I2", 0.0)
-        i12 = c.real(6, "I12", 0.0)
-        j = c.real(7, "J", 0.0)
-        nsm = c.real(8, "NSM", 0.0)
-        i = 9
-        if i < len(c) and not isinstance(c.raw(9), str):
-            i = 17  # stress recovery points at end A
-        end_a = (a, i1, i2, i12, j, nsm)
-        while i < len(c) and isinstance(c.raw(i), str):
-            so = c.text(i, "SO")
-            if so not in _STRESS_SO:
-                raise c.error(f"SO {so!r} must be YES, YESA or NO")
-            vals = tuple(c.real(i + 2 + k, "station value", end_a[k]) for k in range(6))
-            if not np.allclose(vals, end_a, rtol=1e-9, atol=0.0):
-                raise c.error(
-                    "tapered beams are not supported", "give a uniform PBEAM (end B = end A)"
-                )
-            i += 16 if so == "YES" else 8
-        k1 = c.real(i, "K1", 1.0)
-        k2 = c.real(i + 1, "K2", 1.0)
-        extra = [c.real(i + k, "field", 0.0) for k in range(4, 16)]
-        nsi = extra[0:2]
-        cw = extra[2:4]
-        mn = extra[4:12]
-        if any(mn) or any(nsi):
-            raise c.error(
-                "non-structural mass inertia or offsets (NSI, M1-N2) are not supported",
-                "remove them or model the offset mass with CONM2",
-            )
-        if any(cw):
-            self.warnings.append(f"{c.where}: warping coefficients CW ignored (no warping DOFs)")
-        return _BeamProp(a, i1, i2, i12, j, nsm, k1 or None, k2 or None, mid, c)
-
-    def section(self, prop: _BeamProp, mat: _Material, wt: float) -> BeamSection:
-        sc = self.sc
-        L2, L4 = sc.length**2, sc.length**4
-        a, i1, i2, j = prop.a * L2, prop.i1 * L4, prop.i2 * L4, prop.j * L4
-        c = prop.card
-        if not (a > 0 and i1 > 0 and i2 > 0 and j > 0):
-            raise c.error(
-                "A, I1, I2 and J must be > 0 for a beam, got "
-                f"{prop.a}, {prop.i1}, {prop.i2}, {prop.j}"
-            )
-        if mat.g <= 0:
-            raise mat.card.error(
-                "G is zero: the beams using it have no torsional stiffness", "give G or NU"
-            )
-        rho = mat.rho * wt * sc.mass / sc.length**3
-        nsm = prop.nsm * wt * sc.mass / sc.length
-        mpl = rho * a + nsm
-        shear = [None if k is None else k * mat.g * a for k in (prop.k1, prop.k2)]
-        return BeamSection(
-            f"{c.name.lower()}:{c.raw(1)}",
-            mat.e * a,
-            mat.e * i2,
-            mat.e * i1,
-            mat.g * j,
-            mpl,
-            rho * (i1 + i2),
-            shear[0],
-            shear[1],
-            0.0,
-            0.0,
-            mat.e * prop.i12 * L4,
-        )
-
     # ---- elements
 
     def orientation(
@@ -875,8 +389,7 @@ class _Deck:
                 "give X1, X2, X3 or G0",
             )
         if isinstance(x1, int):
-            g0 = self.grid(x1, src, pos, "G0")
-            del g0
+            self.grid(x1, src, pos, "G0")  # G0 must exist
             return pos[x1] - pos[ga], offt
         v = np.array([src.real(5 + k, f"X{k + 1}", 0.0) for k in range(3)])
         if offt[0] == "G":
@@ -885,8 +398,8 @@ class _Deck:
 
     def beams(
         self,
-        props: dict[int, _BeamProp],
-        mats: dict[int, _Material],
+        props: dict[int, BeamProperty],
+        mats: dict[int, Material],
         pos: dict[int, np.ndarray],
         axes: dict[int, np.ndarray],
         wt: float,
@@ -919,7 +432,9 @@ class _Deck:
                         f"property {pid} is a {prop.card.name}; a CBEAM needs a PBEAM or PBEAML"
                     )
                 if pid not in sections:
-                    sections[pid] = self.section(prop, self.material(mats, prop.mid, prop.card), wt)
+                    sections[pid] = beam_section(
+                        prop, material(mats, prop.mid, prop.card), wt, self.sc
+                    )
                 ga_id, gb_id = c.raw(3), c.raw(4)
                 ga = self.grid(ga_id, c, pos, "GA")
                 gb = self.grid(gb_id, c, pos, "GB")
@@ -957,7 +472,7 @@ class _Deck:
         return out
 
     def rods(
-        self, mats: dict[int, _Material], pos: dict[int, np.ndarray], wt: float
+        self, mats: dict[int, Material], pos: dict[int, np.ndarray], wt: float
     ) -> list[RodElement]:
         sc = self.sc
         props = self.by_id(("PROD",), "rod property")
@@ -977,10 +492,10 @@ class _Deck:
                     p.real(6, "NSM", 0.0),
                 )
                 g1, g2 = c.raw(3), c.raw(4)
-                mat = self.material(mats, mid, p)
+                mat = material(mats, mid, p)
             else:
                 g1, g2 = c.raw(2), c.raw(3)
-                mat = self.material(mats, c.integer(4, "MID"), c)
+                mat = material(mats, c.integer(4, "MID"), c)
                 a, j, nsm = c.real(5, "A"), c.real(6, "J", 0.0), c.real(8, "NSM", 0.0)
             n1 = self.grid(g1, c, pos, "G1")
             n2 = self.grid(g2, c, pos, "G2")
@@ -1008,32 +523,7 @@ class _Deck:
         frames: dict[int, CoordinateFrame],
     ) -> list[Spring]:
         sc = self.sc
-        props: dict[int, tuple[np.ndarray, np.ndarray, float]] = {}
-        for pid, c in self.by_id(("PBUSH",), "bush property").items():
-            k = np.zeros(6)
-            b = np.zeros(6)
-            ge = 0.0
-            i = 2
-            while i < len(c):
-                kw = c.raw(i)
-                vals = [c.real(i + 1 + m, f"{kw}{m + 1}", 0.0) for m in range(6)]
-                if kw == "K":
-                    k = np.array(vals)
-                elif kw == "B":
-                    b = np.array(vals)
-                elif kw == "GE":
-                    ge = vals[0]
-                    if any(v not in (0.0, ge) for v in vals[1:]):
-                        raise c.error("GE per direction is not supported", "give one GE1")
-                elif kw in ("RCV", None):
-                    pass
-                else:
-                    raise c.error(f"PBUSH line {kw!r} is not supported (K, B, GE, RCV are)")
-                i += 8
-            if np.any(k < 0) or np.any(b < 0):
-                raise c.error("negative stiffness or damping")
-            kscale = np.array([sc.force / sc.length] * 3 + [sc.force * sc.length] * 3)
-            props[pid] = (np.diag(k * kscale), np.diag(b * kscale * sc.time), ge)
+        props = bush_properties(self.by_id(("PBUSH",), "bush property"), sc)
         out: list[Spring] = []
         for eid, c in self.by_id(("CBUSH",), "element").items():
             pid = c.integer(2, "PID", eid)
@@ -1083,18 +573,9 @@ class _Deck:
 
     def scalar_springs(self) -> list[ScalarSpring]:
         sc = self.sc
-        pelas: dict[int, tuple[float, float, Card]] = {}
-        for c in self.cards:
-            if c.name == "PELAS":
-                for base in (1, 5):
-                    pid = c.raw(base)
-                    if pid is None:
-                        continue
-                    if not isinstance(pid, int) or pid in pelas:
-                        raise c.error(f"PELAS id {pid!r} is invalid or duplicate")
-                    pelas[pid] = (c.real(base + 1, "K"), c.real(base + 2, "GE", 0.0), c)
+        pelas = scalar_spring_properties([c for c in self.cards if c.name == "PELAS"])
         out: list[ScalarSpring] = []
-        grids = getattr(self, "grid_cards", {})
+        grids = self.grid_cards
         for eid, c in self.by_id(("CELAS1", "CELAS2"), "element").items():
             if c.name == "CELAS1":
                 pid = c.integer(2, "PID", eid)
@@ -1318,7 +799,7 @@ def grid_geometry(
     """
     cards, case = read_cards(path)
     keep = [c for c in cards if c.name in ("GRID", "CORD2R", "CORD2C", "CORD2S")]
-    deck = _Deck(keep, case, str(path), _Scales(1.0, 1.0, 1.0), None, None)
+    deck = _Deck(keep, case, str(path), Scales(1.0, 1.0, 1.0), None, None)
     frames = deck.frames()
     _, pos, _ = deck.grids(frames)
     missing = [int(g) for g in ids if int(g) not in pos]
@@ -1381,7 +862,7 @@ def load_bdf(
     else:
         system = parse_units(str(units), where="units")
     cards, case = read_cards(path)
-    sc = _Scales(system.length_m, system.force_N, system.time_s)
+    sc = Scales(system.length_m, system.force_N, system.time_s)
     deck = _Deck(cards, case, str(path), sc, wtmass, spc)
     graph = deck.build()
     if not points:
