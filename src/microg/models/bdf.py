@@ -29,7 +29,7 @@ different is an error).
 **Element formulation** follows NASTRAN: lumped mass unless ``PARAM,COUPMASS`` > 0; shear
 flexibility from PBAR/PBEAM K1, K2 (PBAR blank: none; PBEAM default 1.0; 0.0: none) and from
 the PBARL/PBEAML section (:data:`~microg.models.bdf_properties.SECTION_SHEAR_FACTORS`);
-see :mod:`microg.structure.frame`.
+see :mod:`microg.structure.elements`.
 """
 
 from __future__ import annotations

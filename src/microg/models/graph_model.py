@@ -23,7 +23,7 @@ Conventions (all values SI: m, kg, s, N, rad):
 * **Springs** (CBUSH) take their axes from a coordinate system, or from their nodes and an
   orientation vector (:func:`spring_axes`).
 * **Mass formulation** is the model's: ``"lumped"`` (NASTRAN's default) or ``"consistent"``
-  (NASTRAN's ``PARAM,COUPMASS``); :mod:`microg.structure.frame` documents both.
+  (NASTRAN's ``PARAM,COUPMASS``); :mod:`microg.structure.elements` documents both.
 """
 
 from __future__ import annotations

@@ -1,15 +1,15 @@
 """Three-dimensional frame finite elements of a free-free tree-of-beams station.
 
 The tree station is a convenience that generates a frame graph: :func:`build_fem` meshes it
-with :func:`microg.structure.frame.graph_from_station` (the one mesher) and assembles that
-graph with :func:`microg.structure.frame.assemble_frame` (the one assembler and the element
-kernels), then keeps what only a tree has: its exact flexibility (:class:`FrameTree`), used
-by the modal solvers.  Each beam is cut into 12-DOF Euler-Bernoulli frame elements (3
-translations and 3 small rotations per node) with consistent mass; each rigid body is one
-6-DOF master node.  The :class:`FrameStructure` has sparse (CSR) mass and stiffness
-matrices and is always free-free: no degree of freedom is constrained.  (Validation against
-clamped textbook beams deletes DOFs afterwards with :func:`constrain`.)  Massless
-coordinates are kept (the solvers condense them exactly).
+with :func:`microg.structure.mesh.graph_from_station` (the one mesher) and assembles that
+graph with :func:`microg.structure.assembly.assemble_frame` (the one assembler, with the
+kernels of :mod:`microg.structure.elements`), then keeps what only a tree has: its exact
+flexibility (:class:`FrameTree`), used by the modal solvers. Each beam is cut into 12-DOF
+Euler-Bernoulli frame elements (3 translations and 3 small rotations per node) with
+consistent mass; each rigid body is one 6-DOF master node. The :class:`FrameStructure` has
+sparse (CSR) mass and stiffness matrices and is always free-free: no degree of freedom is
+constrained. (Validation against clamped textbook beams deletes DOFs afterwards with
+:func:`constrain`.) Massless coordinates are kept (the solvers condense them exactly).
 
 Modelling assumptions, each a documented choice:
 
@@ -60,7 +60,7 @@ Modelling assumptions, each a documented choice:
   trace (zero to rounding: point masses on one line with no rotary inertia, a single point
   mass) is refused, naming the components: that rotation has neither inertia nor
   stiffness, a mechanism (:func:`check_rotary_inertia`).
-* **Size.**  Meshes beyond :data:`~microg.structure.frame.MAX_FEM_DOF` degrees of freedom
+* **Size.**  Meshes beyond :data:`~microg.structure.assembly.MAX_FEM_DOF` degrees of freedom
   are refused before any node is made.
 * **Exact flexibility** (:class:`FrameTree`).  The model is a tree: every node but the root
   body's master is the far end of exactly one element.  With ``d_e = x_b - x_a`` the
@@ -86,22 +86,23 @@ import numpy as np
 from microg.errors import InputError
 from microg.models.graph_model import ConcentratedMass
 from microg.models.station import POLAR_GYRATION_FRACTION, Station
-from microg.structure.frame import (
-    AXIAL_PENALTY,
-    DEFAULT_ELEMENTS_PER_BEAM,
+from microg.structure.assembly import MAX_FEM_DOF, assemble_frame
+from microg.structure.elements import (
     DOF_NAMES,
-    GJ_ZERO_FRACTION,
-    MAX_FEM_DOF,
-    TORSION_PENALTY,
-    _mass_properties,
-    _skew,
-    assemble_frame,
     frame_mass_local,
     frame_rotation,
     frame_stiffness_local,
-    graph_from_station,
     point_mass_matrix,
     rigid_link,
+    skew,
+)
+from microg.structure.mesh import (
+    AXIAL_PENALTY,
+    DEFAULT_ELEMENTS_PER_BEAM,
+    GJ_ZERO_FRACTION,
+    TORSION_PENALTY,
+    graph_from_station,
+    station_mass_properties,
     torsion_is_rigid,
 )
 from microg.structure.structure import PointMap, Structure
@@ -271,10 +272,6 @@ class FrameTree:
         c = sp.csr_matrix((vals, (rows, cols)), shape=(n, n))
         c.eliminate_zeros()
         return c
-
-    def stiffness_blocks(self) -> np.ndarray:
-        """``D``'s element blocks (ne, 6, 6): the inverse of :attr:`flexibility`."""
-        return np.linalg.inv(self.flexibility)
 
     def factor(self) -> TreeFlexibility:
         """An operator applying ``G`` (the triangular factor is made once, O(n))."""
@@ -509,8 +506,8 @@ def build_fem(
 ) -> FrameStructure:
     """Assemble the free-free frame finite-element model of ``station``.
 
-    The station is meshed into a graph (:func:`microg.structure.frame.graph_from_station`)
-    and assembled by :func:`microg.structure.frame.assemble_frame`; the tree of the mesh
+    The station is meshed into a graph (:func:`microg.structure.mesh.graph_from_station`)
+    and assembled by :func:`microg.structure.assembly.assemble_frame`; the tree of the mesh
     gives the exact flexibility (:class:`FrameTree`).
 
     Parameters
@@ -575,7 +572,7 @@ def build_fem(
     n = 6 * n_nodes
     index = graph.node_index()
 
-    total, cm, inertia = _mass_properties(station)
+    total, cm, inertia = station_mass_properties(station)
     root_node = index[station.bodies[0].name]  # the root body's node is named after it
     root_k = np.zeros(6)
     if gravity_gradient:
@@ -626,7 +623,7 @@ def build_fem(
         tr = np.zeros((3, n))
         rot = np.zeros((3, n))
         tr[:, 6 * node : 6 * node + 3] = np.eye(3)
-        tr[:, 6 * node + 3 : 6 * node + 6] = -_skew(off)
+        tr[:, 6 * node + 3 : 6 * node + 6] = -skew(off)
         rot[:, 6 * node + 3 : 6 * node + 6] = np.eye(3)
         points[p.name] = PointMap(
             name=p.name, position=np.asarray(p.position, float), translation=tr, rotation=rot
