@@ -21,7 +21,7 @@ other card is *unsupported* and the whole deck is refused with one :class:`Input
 each unsupported card with its count.  Nothing is dropped silently.
 
 **Units.**  NASTRAN decks declare none: ``units="LENGTH, FORCE, TIME"`` is required (e.g.
-``"in, lbf, s"``, ``"mm, N, s"``, ``"m, N, s"``; :func:`microg.models.modal.parse_units`);
+``"in, lbf, s"``, ``"mm, N, s"``, ``"m, N, s"``; :func:`microg.models.file_units.parse_units`);
 the mass unit is FORCE TIME^2 / LENGTH.  Mass input (densities, non-structural mass, CONM2)
 is multiplied by WTMASS (``PARAM,WTMASS``, or the ``wtmass`` argument; both given and
 different is an error).
@@ -65,6 +65,7 @@ from microg.models.coords import (
     chain_cord2,
     nastran_coordinates,
 )
+from microg.models.file_units import UnitSystem, parse_units
 from microg.models.graph_check import validate_graph
 from microg.models.graph_model import (
     BeamElement,
@@ -82,7 +83,7 @@ from microg.models.graph_model import (
     parse_components,
     spring_axes,
 )
-from microg.models.modal import ModalPoint, UnitSystem, parse_units
+from microg.models.modal import ModalPoint
 
 __all__ = [
     "IGNORED_CARDS",
@@ -831,7 +832,7 @@ def load_bdf(
         The deck; INCLUDE files are read relative to it.
     units : str or UnitSystem
         ``"LENGTH, FORCE, TIME"`` of the deck, e.g. ``"in, lbf, s"``
-        (:func:`microg.models.modal.parse_units`); required: NASTRAN files declare none.
+        (:func:`microg.models.file_units.parse_units`); required: NASTRAN files declare none.
     wtmass : float, optional
         Factor from the deck's mass input to FORCE TIME^2/LENGTH (NASTRAN ``PARAM,WTMASS``);
         default the deck's, else 1.  Contradicting the deck's is an error.  (A UnitSystem's

@@ -8,7 +8,8 @@ Dispatch by suffix:
 * ``.unv`` / ``.uff``: UFF 15/2411 + 55 (+164) (:func:`microg.models.uff.modal_model_from_uff`);
 * ``.npz``: microg's own modal-model file (:func:`microg.models.modal.load_modal_model`);
 * ``.toml`` or a shipped name: a station (:func:`microg.models.toml.load_station`);
-* ``.bdf`` / ``.dat``: a NASTRAN deck, solved by microg's frame FE (``microg.models.bdf``).
+* ``.bdf`` / ``.dat``: a NASTRAN deck, solved by microg's frame FE
+  (:func:`microg.models.bdf.load_bdf`).
 
 NASTRAN files declare no units: ``units`` (``"in, lbf, s"``) is required for them, from the
 argument or the points file; a missing declaration is an error, never a guess.
@@ -44,7 +45,7 @@ def _units(
                 fix='state them, e.g. units="in, lbf, s" (or in the points file)',
             )
         return None
-    from microg.models.modal import parse_units
+    from microg.models.file_units import parse_units
 
     return parse_units(text, where="units", wtmass=wt)
 
@@ -122,12 +123,10 @@ def load_model(
         _only_for_foreign_files(units, wtmass, "a station or graph model")
         return load_station(p)
     if suffix in (".bdf", ".dat"):
-        try:
-            from microg.models import bdf
-        except ImportError:
-            raise InputError("the NASTRAN deck reader is not available yet", where=label) from None
+        from microg.models.bdf import load_bdf
+
         u = _units(units, wtmass, opts, label, need=True)
-        return bdf.load_bdf(p, units=u, points=opts.points)
+        return load_bdf(p, units=u, points=opts.points)
     if not p.is_file():
         raise InputError("no such file", where=label)
     if suffix == ".npz":

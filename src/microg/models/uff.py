@@ -1,8 +1,10 @@
 """Universal File Format (UFF): nodes (15, 2411), modes (55), units (164), time histories (58).
 
-microg's own reader and writer, vectorised (no loop over nodes in Python formatting of the
-numbers is avoided where numpy can do it; pyuff formats node by node and reads dataset 55
-in fixed 13-column fields, which limits it to 6 significant digits).
+microg's own reader and writer, vectorised (numbers parsed and formatted by numpy, not node
+by node).  pyuff is not used: it writes dataset 55 only as ``E13.5`` (6 significant digits)
+and reads it in fixed 13-column fields, so it can neither write nor read the lossless
+``precision="double"`` files below; it is the tests' independent reader of the standard
+single-precision files.
 
 Precision.  The standard writes dataset 55 values as ``6E13.5`` (6 significant digits)
 and dataset 15 coordinates as ``3E13.5``; ``precision="single"`` (the default) writes
@@ -34,13 +36,8 @@ from typing import Any
 import numpy as np
 
 from microg.errors import InputError
-from microg.models.modal import (
-    SI_UNITS,
-    ModalModel,
-    ModalPoint,
-    UnitSystem,
-    build_modal_model,
-)
+from microg.models.file_units import UnitSystem
+from microg.models.modal import ModalModel, ModalPoint, build_modal_model
 
 __all__ = [
     "UffDataset",
@@ -128,11 +125,15 @@ def data_values(lines: Sequence[str], where: str, width: int) -> np.ndarray:
 
 
 def dataset_units(ds: UffDataset, where: str) -> UnitSystem:
-    """The unit system of a dataset 164 (SI value = file value / factor)."""
-    return _units164(ds, where)
+    """The unit system of a dataset 164 (SI value = file value / factor).
 
-
-def _units164(ds: UffDataset, where: str) -> UnitSystem:
+    Parameters
+    ----------
+    ds : UffDataset
+        A dataset 164.
+    where : str
+        The file, for errors.
+    """
     rec1 = ds.lines[0]
     nums = _numbers(ds.lines[1:], where)
     if nums.size < 2:
@@ -160,7 +161,7 @@ def _mode55(ds: UffDataset, where: str) -> dict[str, Any]:
     rec6 = ln[5].split()
     if len(rec6) < 6:
         raise InputError(f"line {ds.start_line + 5}: dataset 55 record 6 is cut", where=where)
-    analysis, data_ch, data_type, ndv = int(rec6[1]), int(rec6[2]), int(rec6[4]), int(rec6[5])
+    analysis, data_type, ndv = int(rec6[1]), int(rec6[4]), int(rec6[5])
     if analysis != 2:
         raise InputError(
             f"line {ds.start_line}: dataset 55 of analysis type {analysis}; only normal modes (2)",
@@ -173,7 +174,7 @@ def _mode55(ds: UffDataset, where: str) -> dict[str, Any]:
             where=where,
         )
     rec7 = ln[6].split()
-    nint, nreal = int(rec7[0]), int(rec7[1])
+    nreal = int(rec7[1])
     mode_n = int(rec7[3]) if len(rec7) > 3 else 0
     nreal_lines = (nreal + 5) // 6
     reals = _numbers(ln[7 : 7 + nreal_lines], where)
@@ -190,7 +191,6 @@ def _mode55(ds: UffDataset, where: str) -> dict[str, Any]:
     else:
         rows = nums.reshape(-1, ndv + 1)
         ids, vals = rows[:, 0].astype(np.int64), rows[:, 1:]
-    del nint, data_ch
     return {
         "mode": mode_n,
         "freq_hz": float(reals[0]),
@@ -225,7 +225,7 @@ def modal_model_from_uff(
     where = str(path)
     sets = read_uff(path)
     u164 = [d for d in sets if d.number == 164]
-    file_units = _units164(u164[0], where) if u164 else None
+    file_units = dataset_units(u164[0], where) if u164 else None
     if file_units is None and units is None:
         raise InputError(
             "no units: the file has no dataset 164 and no unit declaration was given",
@@ -358,7 +358,6 @@ def _mode_block(
     name: str,
     precision: str,
 ) -> str:
-    n = ids.size
     dtype = 2 if precision == "single" else 4
     head = (
         f"{name[:80]:<80s}\nmicrog mass-normalised mode shapes (SI)\nNONE\n"
@@ -375,7 +374,6 @@ def _mode_block(
         vals = _fmt_rows(values, "%25.16E" * 6).splitlines()
     idl = [f"{int(i):10d}" for i in ids]
     body = "".join(f"{a}\n{b}\n" for a, b in zip(idl, vals, strict=True))
-    del n
     return _block(55, head + body)
 
 
@@ -546,7 +544,3 @@ def write_uff_time(
     out = Path(path)
     atomic_write_text(out, "".join(parts))
     return out
-
-
-# a file written in SI declares code 1; exposed for the tests of the unit handling
-SI = SI_UNITS

@@ -4,13 +4,14 @@ The coordinates are the model's mass-normalised modal coordinates ``eta`` (m sqr
 ``M = I`` and ``K = diag(omega^2)`` exactly.  A point riding on grid ``g`` at offset ``d``
 moves by ``u = u_g + theta_g x d``: its translation map is ``phi_T[g] - [d]x phi_R[g]``
 (3, m) and its rotation map ``phi_R[g]`` (3, m), the same rigid-offset rule as the frame
-elements (:func:`microg.structure.fem.rigid_link`).
+elements (:func:`microg.structure.elements.rigid_link`).
 
 The exact rigid-body vectors: the rigid modes are exact rigid motions ``phi_r = R0 A``
-(``R0`` the unit rigid motions about the basic origin, :func:`microg.models.modal.rigid_basis_at`),
-so a unit rigid motion ``e_d`` is the coordinate vector with ``A q = e_d`` on the rigid
-modes and 0 elsewhere; ``K`` annihilates it exactly (its diagonal is exactly 0 there).
-The rigid-body mass is ``(A A^T)^-1`` (from ``A^T M_rr A = I``).
+(``R0`` the unit rigid motions about the basic origin,
+:func:`microg.models.rigid_modes.rigid_basis_at`), so a unit rigid motion ``e_d`` is the
+coordinate vector with ``A q = e_d`` on the rigid modes and 0 elsewhere; ``K`` annihilates
+it exactly (its diagonal is exactly 0 there). The rigid-body mass is ``(A A^T)^-1`` (from
+``A^T M_rr A = I``).
 
 Point maps are built only for the points asked for: :class:`GridPointMaps` lists the
 named points and the requested grids, and builds the map of any other ``grid:N`` on first
@@ -26,7 +27,8 @@ from collections.abc import Iterator, Mapping, Sequence
 import numpy as np
 
 from microg.errors import InputError, ModelError
-from microg.models.modal import ModalModel, rigid_basis_at
+from microg.models.modal import ModalModel
+from microg.models.rigid_modes import rigid_basis_at
 from microg.structure.structure import PointMap, Structure
 
 __all__ = [

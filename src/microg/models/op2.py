@@ -1,0 +1,571 @@
+"""NASTRAN OP2 files: the OUTPUT2 records and the tables of a SOL 103 run, file units.
+
+microg's own reader (pure numpy; no third-party reader works on numpy 2 for every table
+needed here):
+
+* the OUTPUT2 record structure, little- or big-endian, 32- or 64-bit words, with or
+  without the "NASTRAN FORT TAPE ID CODE" header (MSC and Simcenter/NX files);
+* ``LAMA``: mode number, extraction order, eigenvalue, radians, cycles, generalized mass
+  and stiffness of each real mode;
+* ``OUGV1`` / ``BOUGV1`` real eigenvectors (approach code 2, table code 7) in SORT1 (one
+  record per mode) and SORT2 (one record per grid), grids and scalar points;
+* geometry: ``GEOM1``/``GEOM1S`` GRID and CORD2R/C/S records (coordinate systems chained
+  through their reference systems, :func:`microg.models.coords.chain_cord2`), else
+  ``BGPDT``/``BGPDTS`` + ``EQEXIN``/``EQEXINS``; eigenvectors in a grid's output system
+  (CD) are rotated to the basic frame (cylindrical and spherical systems at the grid's own
+  angles, :meth:`Op2Modes.shapes_basic`), unless the table is BOUGV1 or PARAM OUGCORD is
+  BASIC;
+* ``OGPWG``: the grid point weight generator's 6x6 rigid-body mass about its reference
+  point (input mass units, so times WTMASS), used for exact rigid-body modes;
+* ``PVT0``: the run's PARAMs (WTMASS, OUGCORD, GRDPNT).
+
+:func:`microg.models.nastran.modal_model_from_op2` converts what is read to SI.
+"""
+
+from __future__ import annotations
+
+import struct
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from microg.errors import InputError
+from microg.models.coords import (
+    NASTRAN_KINDS,
+    CoordinateFrame,
+    Cord2,
+    chain_cord2,
+    nastran_coordinates,
+)
+
+__all__ = ["Op2File", "Op2Modes", "read_op2_modes"]
+
+
+# --------------------------------------------------------------------------- records
+
+
+class Op2File:
+    """The data blocks of an OP2 file: name -> list of tables, each a list of records.
+
+    Attributes
+    ----------
+    path : str
+    endian : str
+        ``"<"`` or ``">"``.
+    word : int
+        4 (32-bit) or 8 (64-bit) bytes.
+    tables : list of (name, trailer, records)
+        In file order; ``records`` are the logical records' bytes (record 0 is the
+        header record holding the name).
+    """
+
+    def __init__(self, path: str | Path):
+        self.path = str(path)
+        try:
+            data = Path(path).read_bytes()
+        except FileNotFoundError:
+            raise InputError("no such file", where=self.path) from None
+        except OSError as exc:
+            raise InputError(f"cannot read: {exc.strerror or exc}", where=self.path) from None
+        if len(data) < 8:
+            raise InputError("not an OP2 file (shorter than one record)", where=self.path)
+        first_le = struct.unpack("<i", data[:4])[0]
+        first_be = struct.unpack(">i", data[:4])[0]
+        if first_le in (4, 8):
+            self.endian, self.word = "<", first_le
+        elif first_be in (4, 8):
+            self.endian, self.word = ">", first_be
+        else:
+            raise InputError(
+                "not an OP2 file (the first Fortran record marker is not 4 or 8)",
+                where=self.path,
+            )
+        self._data = data
+        self._records = self._scan(data)
+        self.tables = self._split()
+
+    def _fail(self, what: str) -> InputError:
+        return InputError(f"truncated or corrupt OP2: {what}", where=self.path)
+
+    def _scan(self, data: bytes) -> list[tuple[int, int]]:
+        n = len(data)
+        fmt = self.endian + "i"
+        out = []
+        i = 0
+        while i < n:
+            if i + 4 > n:
+                raise self._fail(f"a record marker is cut at byte {i}")
+            length = struct.unpack_from(fmt, data, i)[0]
+            end = i + 4 + length
+            if length < 0 or end + 4 > n:
+                raise self._fail(f"the record at byte {i} runs past the end of the file")
+            if struct.unpack_from(fmt, data, end)[0] != length:
+                raise self._fail(f"the record at byte {i} has mismatched length markers")
+            out.append((i + 4, end))
+            i = end + 4
+        return out
+
+    def _key(self, k: int) -> int | None:
+        if k >= len(self._records):
+            return None
+        a, b = self._records[k]
+        if b - a != self.word:
+            return None
+        return int(
+            struct.unpack_from(self.endian + ("i" if self.word == 4 else "q"), self._data, a)[0]
+        )
+
+    def _bytes(self, k: int) -> bytes:
+        a, b = self._records[k]
+        return self._data[a:b]
+
+    def _split(self) -> list[tuple[str, np.ndarray, list[bytes]]]:
+        recs = self._records
+        k = 0
+        if self._key(0) == 3 and len(recs) > 1 and recs[1][1] - recs[1][0] == 3 * self.word:
+            # MSC header: date, "NASTRAN FORT TAPE ID CODE", label, then -1, 0
+            while k < len(recs) and self._key(k) != 0:
+                k += 1
+            k += 1
+        tables = []
+        while k < len(recs):
+            n = self._key(k)
+            if n is None:
+                raise self._fail(f"expected a data block name at record {k}")
+            if n == 0:
+                break
+            if k + 8 > len(recs):
+                raise self._fail("a data block header is cut")
+            name = self._bytes(k + 1)[:8].decode("latin1").strip()
+            trailer = np.frombuffer(
+                self._bytes(k + 4), self.endian + ("i4" if self.word == 4 else "i8")
+            )
+            k += 8
+            logical: list[bytes] = []
+            while True:
+                n = self._key(k)
+                if n is None:
+                    raise self._fail(f"data block {name} ends without its end marker")
+                if n == 0:
+                    k += 1
+                    break
+                if n > 0:
+                    parts = []
+                    while n is not None and n > 0:
+                        if k + 1 >= len(recs):
+                            raise self._fail(f"data block {name} is cut")
+                        parts.append(self._bytes(k + 1))
+                        k += 2
+                        n = self._key(k)
+                    logical.append(b"".join(parts))
+                if n is None or n >= 0:
+                    raise self._fail(f"data block {name}: bad record marker at record {k}")
+                k += 3  # -r, 1, 0
+            tables.append((name, trailer, logical))
+        return tables
+
+    def ints(self, rec: bytes) -> np.ndarray:
+        """Record as integers."""
+        return np.frombuffer(rec, self.endian + ("i4" if self.word == 4 else "i8"))
+
+    def floats(self, rec: bytes) -> np.ndarray:
+        """Record as reals."""
+        return np.frombuffer(rec, self.endian + ("f4" if self.word == 4 else "f8"))
+
+    def named(self, *names: str) -> list[tuple[str, np.ndarray, list[bytes]]]:
+        """Tables whose name is one of ``names``, in file order."""
+        return [t for t in self.tables if t[0] in names]
+
+
+# --------------------------------------------------------------------------- OP2 tables
+
+
+@dataclass(frozen=True)
+class Op2Modes:
+    """Real modes read from an OP2, in the file's units and output systems.
+
+    Attributes
+    ----------
+    path : str
+    table : str
+        ``"OUGV1"`` or ``"BOUGV1"``.
+    sort : str
+        ``"SORT1"`` or ``"SORT2"``.
+    mode : ndarray (m,) int
+    eigenvalue : ndarray (m,)
+        omega^2 in 1/time^2 (LAMA).
+    generalized_mass : ndarray (m,)
+        LAMA's generalized masses (mass x length^2 in consistent units).
+    grid_ids : ndarray (g,) int
+        Grids (scalar points excluded).
+    shapes : ndarray (g, 6, m)
+        Eigenvector components T1..R3 as in the file (each grid's output system).
+    cd : ndarray (g,) int
+        Output system of each grid's components (0 when the table is in basic).
+    xyz_basic : ndarray (g, 3) or None
+        Grid positions in basic (file length unit).
+    coords : dict of int to CoordinateFrame
+        Coordinate systems by id, origins in the file's length unit.
+    rigid_mass : ndarray (6, 6) or None
+        OGPWG's MO about ``rigid_mass_ref`` (input mass units: multiply by WTMASS).
+    rigid_mass_ref : ndarray (3,) or None
+        Basic coordinates of the OGPWG reference point.
+    params : dict
+        PARAMs from PVT0.
+    n_scalar : int
+        Scalar points dropped.
+    """
+
+    path: str
+    table: str
+    sort: str
+    mode: np.ndarray
+    eigenvalue: np.ndarray
+    generalized_mass: np.ndarray
+    grid_ids: np.ndarray
+    shapes: np.ndarray
+    cd: np.ndarray
+    xyz_basic: np.ndarray | None
+    coords: dict[int, CoordinateFrame] = field(default_factory=dict)
+    rigid_mass: np.ndarray | None = None
+    rigid_mass_ref: np.ndarray | None = None
+    params: dict[str, Any] = field(default_factory=dict)
+    n_scalar: int = 0
+
+    @property
+    def freq_hz_signed(self) -> np.ndarray:
+        """sign(eigenvalue) sqrt(|eigenvalue|) / 2 pi, Hz (file time unit)."""
+        lam = self.eigenvalue
+        return np.sign(lam) * np.sqrt(np.abs(lam)) / (2.0 * np.pi)
+
+    def shapes_basic(self) -> np.ndarray:
+        """Eigenvectors rotated from each grid's output system to basic, (g, 6, m)."""
+        out = np.array(self.shapes, dtype=float)
+        for cid in np.unique(self.cd):
+            if cid == 0:
+                continue
+            sel = np.flatnonzero(self.cd == cid)
+            cs = self.coords.get(int(cid))
+            if cs is None:
+                raise InputError(
+                    f"grids {', '.join(str(g) for g in self.grid_ids[sel[:5]])} give output in "
+                    f"coordinate system {cid}, which the file does not define",
+                    where=self.path,
+                    fix="give the BDF (with its CORD2 cards) beside the OP2",
+                )
+            if self.xyz_basic is None:
+                raise InputError("no grid geometry to rotate output systems", where=self.path)
+            t = np.swapaxes(cs.axes_at(self.xyz_basic[sel]), -1, -2)  # columns: axes
+            out[sel, :3] = np.einsum("nab,nbm->nam", t, out[sel, :3])
+            out[sel, 3:] = np.einsum("nab,nbm->nam", t, out[sel, 3:])
+        return out
+
+
+def _pvt0(f: Op2File) -> dict[str, Any]:
+    params: dict[str, Any] = {}
+    for _, _, recs in f.named("PVT0"):
+        if len(recs) < 2:
+            continue
+        ints, flts = f.ints(recs[1]), f.floats(recs[1])
+        raw = recs[1]
+        w = f.word
+        i = 0
+        try:
+            while i + 3 <= ints.size:
+                name = raw[i * w : (i + 2) * w].decode("latin1")
+                name = name.replace("\x00", " ")[: 8 if w == 4 else 16].strip()
+                kind = int(ints[i + 2])
+                i += 3
+                if kind == 1:
+                    params[name] = int(ints[i])
+                    i += 1
+                elif kind == 2:
+                    params[name] = float(flts[i])
+                    i += 1
+                elif kind == 3:
+                    params[name] = raw[i * w : (i + 2) * w].decode("latin1").strip()
+                    i += 2
+                elif kind == 4:
+                    params[name] = (
+                        float(np.frombuffer(raw[i * w : (i + 2) * w], f.endian + "f8")[0])
+                        if w == 4
+                        else float(flts[i])
+                    )
+                    i += 2 if w == 4 else 1
+                elif kind == 5:
+                    i += 2
+                elif kind == 6:
+                    i += 4 if w == 4 else 2
+                else:
+                    break
+        except (IndexError, UnicodeDecodeError, ValueError):
+            pass
+    return params
+
+
+def _lama(f: Op2File) -> np.ndarray | None:
+    """(m, 7): mode, order, eigenvalue, radians, cycles, genmass, genstiff."""
+    for _, _, recs in f.named("LAMA"):
+        if len(recs) < 3:
+            continue
+        data = recs[2]
+        n = len(data) // (7 * f.word)
+        if n * 7 * f.word != len(data):
+            raise InputError("LAMA record length is not 7 words per mode", where=f.path)
+        ints = f.ints(data).reshape(n, 7)
+        flt = f.floats(data).reshape(n, 7)
+        out = np.empty((n, 7))
+        out[:, :2] = ints[:, :2]
+        out[:, 2:] = flt[:, 2:]
+        return out
+    return None
+
+
+def _geometry(
+    f: Op2File,
+) -> tuple[dict[int, tuple[int, np.ndarray, int]], dict[int, CoordinateFrame]]:
+    """Grid id -> (cp, x in cp, cd) and the coordinate systems, from GEOM1/GEOM1S."""
+    grids: dict[int, tuple[int, np.ndarray, int]] = {}
+    cords: dict[int, Cord2] = {}
+    kinds = {(2101, 21, 8): "R", (2001, 20, 9): "C", (2201, 22, 10): "S"}
+    for _, _, recs in f.named("GEOM1", "GEOM1S"):
+        for rec in recs[1:]:
+            ints = f.ints(rec)
+            if ints.size < 3:
+                continue
+            head = tuple(int(v) for v in ints[:3])
+            body_i, body_f = ints[3:], f.floats(rec)[3:]
+            if head == (4501, 45, 1):
+                n = body_i.size // 8
+                bi, bf = body_i[: 8 * n].reshape(n, 8), body_f[: 8 * n].reshape(n, 8)
+                for r in range(n):
+                    grids.setdefault(
+                        int(bi[r, 0]), (int(bi[r, 1]), bf[r, 2:5].astype(float), int(bi[r, 5]))
+                    )
+            elif head in kinds:
+                n = body_i.size // 13
+                bi, bf = body_i[: 13 * n].reshape(n, 13), body_f[: 13 * n].reshape(n, 13)
+                for r in range(n):
+                    cid = int(bi[r, 0])
+                    letter = kinds[head]
+                    cords.setdefault(
+                        cid,
+                        Cord2(
+                            cid,
+                            NASTRAN_KINDS[letter],
+                            int(bi[r, 3]),
+                            bf[r, 4:13].astype(float).reshape(3, 3),
+                            f"{f.path}: CORD2{letter} {cid}",
+                        ),
+                    )
+            elif head[:2] in ((1701, 17), (1801, 18), (1901, 19)):
+                raise InputError(
+                    "CORD1R/C/S systems (defined by grids) are not supported in the OP2 geometry",
+                    where=f.path,
+                    fix="use CORD2R/C/S, or output in basic (PARAM,OUGCORD,BASIC)",
+                )
+    systems = chain_cord2(list(cords.values()))
+    return grids, systems
+
+
+def _bgpdt(f: Op2File) -> dict[int, tuple[int, np.ndarray]]:
+    """Grid id -> (cd, basic xyz) from BGPDT(S) + EQEXIN(S) (older 4-word layout)."""
+    out: dict[int, tuple[int, np.ndarray]] = {}
+    bg = f.named("BGPDT", "BGPDTS")
+    eq = f.named("EQEXIN", "EQEXINS")
+    for (_, _, brecs), (_, _, erecs) in zip(bg, eq, strict=False):
+        if len(brecs) < 2 or len(erecs) < 2:
+            continue
+        e1 = f.ints(erecs[1]).reshape(-1, 2)  # external id, internal id
+        rec = brecs[1]
+        n = e1.shape[0]
+        nw = len(rec) // f.word
+        if nw != 4 * n:
+            continue  # newer layouts: GEOM1 carries the geometry instead
+        bi, bf = f.ints(rec).reshape(n, 4), f.floats(rec).reshape(n, 4)
+        internal = {int(i): int(e) for e, i in e1}
+        for row in range(n):
+            ext = internal.get(row + 1)
+            if ext is not None and bi[row, 0] >= 0:
+                out.setdefault(ext, (int(bi[row, 0]), bf[row, 1:4].astype(float)))
+    return out
+
+
+def _ogpwg(f: Op2File) -> tuple[np.ndarray, int] | None:
+    for _, _, recs in f.named("OGPWG"):
+        if len(recs) < 3:
+            continue
+        ident = f.ints(recs[1])
+        data = f.floats(recs[2]).astype(float)
+        if data.size < 36:
+            continue
+        return data[:36].reshape(6, 6), int(ident[2]) if ident.size > 2 else 0
+    return None
+
+
+def _eigenvector_tables(f: Op2File) -> list[tuple[str, list[bytes]]]:
+    out = []
+    for name, _, recs in f.named("OUGV1", "BOUGV1", "OUGV2", "BOUGV2"):
+        if len(recs) >= 3:
+            ident = f.ints(recs[1])
+            if ident.size >= 10 and ident[0] // 10 == 2 and ident[1] % 1000 == 7:
+                out.append((name, recs))
+    return out
+
+
+def _read_ougv(
+    f: Op2File, name: str, recs: list[bytes], lama: np.ndarray | None
+) -> tuple[str, np.ndarray, np.ndarray, np.ndarray, np.ndarray, int]:
+    """(sort, mode numbers, eigenvalues from the records, grid ids, shapes (g, 6, m), n_scalar)."""
+    w = f.word
+    pairs = [(recs[i], recs[i + 1]) for i in range(1, len(recs) - 1, 2)]
+    first = f.ints(pairs[0][0])
+    tcode = int(first[1])
+    sort2 = bool((tcode // 1000) & 2)
+    if (tcode // 1000) & 1 or int(first[8]) not in (0, 1) or int(first[9]) != 8:
+        raise InputError(
+            f"{name} holds complex or non-standard eigenvectors (format {int(first[8])}, "
+            f"{int(first[9])} words per entry); only real modes are read",
+            where=f.path,
+        )
+    if not sort2:
+        modes, eig, data = [], [], []
+        for ident, rec in pairs:
+            ii = f.ints(ident)
+            modes.append(int(ii[4]))
+            eig.append(float(f.floats(ident)[5]))
+            data.append(rec)
+        n = len(data[0]) // (8 * w)
+        if any(len(d) != n * 8 * w for d in data):
+            raise InputError(f"{name}: modes have different numbers of points", where=f.path)
+        ints = f.ints(data[0]).reshape(n, 8)
+        ids, types = ints[:, 0] // 10, ints[:, 1]
+        vals = np.stack([f.floats(d).reshape(n, 8)[:, 2:] for d in data], axis=-1)
+    else:
+        ids_l, types_l, cols = [], [], []
+        modes_arr = None
+        for ident, rec in pairs:
+            ii = f.ints(ident)
+            nrow = len(rec) // (8 * w)
+            ri, rf = f.ints(rec).reshape(nrow, 8), f.floats(rec).reshape(nrow, 8)
+            ids_l.append(int(ii[4]) // 10)
+            types_l.append(int(ri[0, 1]))
+            cols.append(rf[:, 2:].T)  # (6, m)
+            if modes_arr is None:
+                key_i = ri[:, 0]
+                if lama is not None and np.all((key_i >= 1) & (key_i <= 10**7)):
+                    modes_arr = key_i.astype(int)
+                elif lama is not None:
+                    lam = lama[:, 2]
+                    key_f = rf[:, 0].astype(float)
+                    modes_arr = np.array([int(lama[np.argmin(np.abs(lam - v)), 0]) for v in key_f])
+                else:
+                    modes_arr = np.arange(1, nrow + 1)
+        ids, types = np.array(ids_l), np.array(types_l)
+        vals = np.stack(cols, axis=0)  # (n, 6, m)
+        modes = list(modes_arr) if modes_arr is not None else []
+        eig = [float("nan")] * len(modes)
+    scalar = types != 1
+    keep = ~scalar
+    return (
+        "SORT2" if sort2 else "SORT1",
+        np.asarray(modes, int),
+        np.asarray(eig, float),
+        np.asarray(ids[keep], np.int64),
+        np.asarray(vals[keep], float),
+        int(np.count_nonzero(scalar)),
+    )
+
+
+def read_op2_modes(path: str | Path) -> Op2Modes:
+    """Read the real modes of a SOL 103 OP2 (see the module docstring).
+
+    Raises
+    ------
+    InputError
+        Not an OP2, truncated or corrupt, no eigenvectors or no eigenvalue table (one line
+        naming the file).
+    """
+    f = Op2File(path)
+    tables = _eigenvector_tables(f)
+    lama = _lama(f)
+    if not tables:
+        names = ", ".join(sorted({t[0] for t in f.tables})) or "none"
+        raise InputError(
+            f"no real eigenvectors (no OUGV1/BOUGV1 table of SOL 103 modes; data blocks: {names})",
+            where=f.path,
+            fix="rerun with DISPLACEMENT(PLOT) = ALL and PARAM,POST,-1 or -2",
+        )
+    name, recs = tables[0]
+    sort, modes, eig_id, ids, shapes, n_scalar = _read_ougv(f, name, recs, lama)
+    if lama is None:
+        raise InputError(
+            "no LAMA table (eigenvalues and generalized masses)",
+            where=f.path,
+            fix="rerun SOL 103 with PARAM,POST so that LAMA is written",
+        )
+    row = {int(mn): r for r, mn in enumerate(lama[:, 0].astype(int))}
+    missing = [int(mn) for mn in modes if int(mn) not in row]
+    if missing:
+        raise InputError(
+            f"{name} mode {missing[0]} has no LAMA entry", where=f.path, fix="check the file"
+        )
+    sel = np.array([row[int(mn)] for mn in modes])
+    params = _pvt0(f)
+    grids, systems = _geometry(f)
+    xyz = None
+    cd = np.zeros(ids.size, int)
+    if grids:
+        miss = [int(g) for g in ids if int(g) not in grids]
+        if miss:
+            raise InputError(
+                f"grid {miss[0]} of {name} is not in the OP2's GEOM1 table", where=f.path
+            )
+        cps = np.array([grids[int(g)][0] for g in ids])
+        local = np.array([grids[int(g)][1] for g in ids])
+        cd = np.array([grids[int(g)][2] for g in ids])
+        xyz = np.zeros((ids.size, 3))
+        for cp in np.unique(cps):
+            cs = systems.get(int(cp))
+            if cs is None:
+                raise InputError(
+                    f"grids refer to coordinate system {cp}, not defined in the OP2", where=f.path
+                )
+            m = cps == cp
+            xyz[m] = cs.to_basic(nastran_coordinates(cs.kind, local[m]))
+    else:
+        bg = _bgpdt(f)
+        if bg and all(int(g) in bg for g in ids):
+            cd = np.array([bg[int(g)][0] for g in ids])
+            xyz = np.array([bg[int(g)][1] for g in ids])
+    basic_output = name.startswith("B") or str(params.get("OUGCORD", "")).upper() == "BASIC"
+    if basic_output:
+        cd = np.zeros(ids.size, int)
+    gp = _ogpwg(f)
+    rm = ref = None
+    if gp is not None:
+        rm, ref_grid = gp
+        ref = np.zeros(3)
+        if ref_grid > 0 and xyz is not None and ref_grid in set(ids.tolist()):
+            ref = xyz[int(np.flatnonzero(ids == ref_grid)[0])]
+        elif ref_grid > 0:
+            rm = None  # reference grid unknown: do not guess its position
+    return Op2Modes(
+        path=f.path,
+        table=name,
+        sort=sort,
+        mode=modes,
+        eigenvalue=lama[sel, 2],
+        generalized_mass=lama[sel, 5],
+        grid_ids=ids,
+        shapes=shapes,
+        cd=cd,
+        xyz_basic=xyz,
+        coords=systems,
+        rigid_mass=rm,
+        rigid_mass_ref=ref,
+        params=params,
+        n_scalar=n_scalar,
+    )
