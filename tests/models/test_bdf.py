@@ -1,4 +1,4 @@
-"""Tests of microg.models.bdf: the card reader, card conversions, units and bad input.
+"""Tests of microg.models.bdf (and bdf_properties): card conversions, units and bad input.
 
 References: the NASTRAN Quick Reference Guide's field layouts and conventions (cited per
 test), hand calculations of coordinate transformations, and, in the ``nastran`` extra's
@@ -14,8 +14,7 @@ import numpy as np
 import pytest
 
 from microg.errors import InputError
-from microg.models.bdf import load_bdf, read_cards
-from microg.models.bdf_cards import _value
+from microg.models.bdf import load_bdf
 from microg.structure.frame import assemble_frame, build_frame
 from microg.units import IN, LBF
 
@@ -70,69 +69,6 @@ DECK_PROPS = (
     "CBAR,1,10,1,2,0.,1.,0.\nCBAR,2,11,2,3,0.,1.,0.\nCBEAM,3,12,3,4,0.,1.,0.\n"
     "CBAR,4,13,1,3,0.,0.,1.\n"
 )
-
-
-# --------------------------------------------------------------------------- reader
-
-
-@pytest.mark.parametrize(
-    ("text", "value"),
-    [
-        ("", None),
-        ("  12 ", 12),
-        ("-3", -3),
-        ("1.5", 1.5),
-        ("1.", 1.0),
-        (".5", 0.5),
-        ("1.5-3", 1.5e-3),
-        ("2.5900-3", 2.59e-3),
-        ("3.0000+7", 3.0e7),
-        ("1.E5", 1.0e5),
-        ("-1.5D-2", -1.5e-2),
-        ("1.5e+02", 150.0),
-        ("MSCBML0", "MSCBML0"),
-        ("rod", "ROD"),
-    ],
-)
-def test_field_values_in_nastran_forms(text, value):
-    # QRG "Bulk Data Entry format": reals need a decimal point; the exponent's E may be
-    # omitted when it is signed (1.5-3 = 1.5E-3); D is a double-precision exponent
-    got = _value(text)
-    assert got == value and type(got) is type(value)
-
-
-def test_small_large_free_fields_continuations_tabs_comments_include(tmp_path):
-    (tmp_path / "sub").mkdir()
-    _deck(
-        tmp_path / "sub",
-        "GRID    4               7.0     8.0     9.0\nINCLUDE 'more.blk'\n",
-        "inc.blk",
-    )
-    _deck(tmp_path / "sub", "GRID,5,,1.,1.,1. $ free field with a comment\n", "more.blk")
-    text = (
-        "SOL 103\nCEND\nSPC = 7\nBEGIN BULK\n"
-        "$ a comment line\n"
-        "GRID    1       0       1.0     2.0     3.0\n"
-        "GRID*   2               0               1.5-3           2.0\n"
-        "*       3.0\n"
-        "CONM2   21      1       0       2.5     0.0     0.0     0.0             +C1\n"
-        "+C1     1.0     0.0     2.0     0.0     0.0     3.0\n"
-        "CONM2   22      1\t0\t1.0\n"  # tabs: 8-column stops
-        "        4.0\n"  # implicit continuation: blank first field
-        "INCLUDE 'sub/inc.blk'\n"
-        "ENDDATA\nGRID,99,,0.,0.,0.\n"
-    )
-    cards, case = read_cards(_deck(tmp_path, text))
-    assert case == ["SPC = 7"]
-    by = {(c.name, c.fields[1]): c for c in cards}
-    assert by["GRID", 1].fields[3:6] == (1.0, 2.0, 3.0)
-    assert by["GRID", 2].fields[2:6] == (0, 1.5e-3, 2.0, 3.0)  # large field, * continuation
-    assert by["CONM2", 21].fields[9:15] == (1.0, 0.0, 2.0, 0.0, 0.0, 3.0)
-    assert by["CONM2", 22].fields[1:4] == (22, 1, 0) and by["CONM2", 22].fields[4] == 1.0
-    assert by["CONM2", 22].fields[9] == 4.0
-    assert by["GRID", 4].fields[3:6] == (7.0, 8.0, 9.0) and by["GRID", 4].file.endswith("inc.blk")
-    assert ("GRID", 5) in by and ("GRID", 99) not in by  # nested INCLUDE; nothing after ENDDATA
-    assert by["GRID", 2].line == 7 and by["GRID", 4].line == 1
 
 
 def test_units_declared_and_converted(tmp_path):

@@ -1,13 +1,12 @@
-"""Tests of microg.models.graph: frames, validation, the graph TOML reader and writer.
+"""Tests of microg.models.graph: validation, the graph TOML reader and writer.
 
-References: hand values of cylindrical and spherical coordinates, the format's own
+References: the format's own
 specification (``docs/model-format.md``, "Graph models", whose example is loaded here),
 and the round trip through :func:`dump_graph`.
 """
 
 from __future__ import annotations
 
-import math
 import re
 from pathlib import Path
 
@@ -17,11 +16,8 @@ import pytest
 from microg.dynamics.modes import solve_modes
 from microg.errors import InputError, ModelError
 from microg.models.graph import (
-    BASIC,
-    CoordinateFrame,
     GraphModel,
     dump_graph,
-    frame_from_points,
     load_graph,
     loads_graph,
     parse_components,
@@ -125,29 +121,7 @@ kind = "crew"
 """
 
 
-# --------------------------------------------------------------------------- frames
-
-
-def test_cylindrical_and_spherical_frames_by_hand():
-    cyl = frame_from_points("c", "cylindrical", [1, 2, 3], [1, 2, 4], [2, 2, 3], where="t")
-    # (r, theta, z) = (2, 90 deg, 1) from origin (1, 2, 3): basic (1, 4, 4)
-    np.testing.assert_allclose(cyl.to_basic([2, math.pi / 2, 1]), [1, 4, 4], atol=1e-14)
-    np.testing.assert_allclose(
-        cyl.axes_at([1, 4, 4]), [[0, 1, 0], [-1, 0, 0], [0, 0, 1]], atol=1e-15
-    )
-    sph = CoordinateFrame("s", "spherical", np.zeros(3), np.eye(3))
-    # (r, theta, phi) = (2, 60 deg, 30 deg): r (sin t cos p, sin t sin p, cos t)
-    t, p = math.radians(60), math.radians(30)
-    np.testing.assert_allclose(
-        sph.to_basic([2, t, p]),
-        2 * np.array([math.sin(t) * math.cos(p), math.sin(t) * math.sin(p), math.cos(t)]),
-    )
-    ax = sph.axes_at(sph.to_basic([2, t, p]))
-    np.testing.assert_allclose(ax @ ax.T, np.eye(3), atol=1e-15)
-    assert np.linalg.det(ax) == pytest.approx(1.0)
-    np.testing.assert_allclose(BASIC.axes_at([5.0, 6, 7]), np.eye(3))
-    with pytest.raises(InputError, match="C lies on the z axis"):
-        frame_from_points("x", "rectangular", [0, 0, 0], [0, 0, 1], [0, 0, 2], where="t")
+# --------------------------------------------------------------------------- components
 
 
 def test_components_parsing():
