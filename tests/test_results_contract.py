@@ -404,7 +404,7 @@ CONTRACT: dict[str, tuple[str, ...]] = {
     # dynamics
     "microg.dynamics.response.ModalResponse": ("to_dict", "to_xarray", "plot"),
     "microg.dynamics.response.PointResponse": ("to_dict", "to_xarray", "plot"),
-    "microg.dynamics.response.PeakResponse": ("to_dict", "to_xarray"),
+    "microg.dynamics.peaks.PeakResponse": ("to_dict", "to_xarray"),
     "microg.isolation.timedomain.IsolationTimeResponse": ("to_dict", "to_xarray", "plot"),
     "microg.analysis.Observation": ("to_dict", "to_xarray", "plot"),
     "microg.analysis.ModeContributions": ("to_dict", "to_xarray"),
@@ -483,6 +483,9 @@ NOT_RESULTS = {
     "microg.dynamics.forces.ForceHistory",
     "microg.dynamics.forces.Activity",
     "microg.dynamics.dense.Eigensolution",  # a solver's step; Modes is the result
+    "microg.dynamics.pwl.ModalState",  # the kernel's state between its two steps
+    "microg.dynamics.superposition.ModalLoad",
+    "microg.dynamics.superposition.Superposition",  # the main job's step; Observation is the result
 }
 
 #: result types in files this contract's owner does not edit, still short of the contract

@@ -28,13 +28,9 @@ from microg._vectors import axis_name, parse_direction
 from microg.dynamics.dense import blas_threads
 from microg.dynamics.forces import ForceHistory, parse_force_spec
 from microg.dynamics.modes import DEFAULT_N_MODES, Modes, solve_modes
-from microg.dynamics.response import (
-    PeakResponse,
-    PointResponse,
-    generalized_force_vector,
-    modal_pwl_evaluate,
-    peak_response,
-)
+from microg.dynamics.peaks import PeakResponse
+from microg.dynamics.response import PointResponse, generalized_force_vector
+from microg.dynamics.superposition import ModalLoad, superpose
 from microg.environment.metrics import Assessment, assess, band_mean_square
 from microg.environment.requirements import (
     BandTable,
@@ -881,15 +877,6 @@ def _force_warnings(opts: AnalysisOptions) -> list[str]:
     return out
 
 
-@dataclass(frozen=True)
-class _Load:
-    """One scalar load of the response: a force history (N) through a generalized force b."""
-
-    force: ForceHistory
-    b: np.ndarray  # (n,) generalized force per newton
-    gamma: np.ndarray  # (k,) modal participation phi^T b
-
-
 def _scalar_parts(d: Disturbance) -> list[tuple[ForceHistory, np.ndarray]]:
     """A disturbance as scalar histories along fixed unit vectors.
 
@@ -910,9 +897,9 @@ def _scalar_parts(d: Disturbance) -> list[tuple[ForceHistory, np.ndarray]]:
 
 def _modal_forces(
     structure: Structure, modes: Modes, opts: AnalysisOptions
-) -> tuple[list[_Load], list[str]]:
+) -> tuple[list[ModalLoad], list[str]]:
     """The scalar loads of every disturbance; refuse a force that does no work."""
-    loads: list[_Load] = []
+    loads: list[ModalLoad] = []
     warnings = []
     for i, d in enumerate(opts.disturbances):
         tmap = structure.point(d.point).translation
@@ -940,7 +927,7 @@ def _modal_forces(
                     f"only {100 * reach:.3g}% of the force {f.name!r} at {d.point!r} acts on "
                     f"the model{inplane}; the rest is dropped"
                 )
-            loads.append(_Load(f, b, modes.phi.T @ b))
+            loads.append(ModalLoad(f, modes.phi.T @ b))
             worked = True
         if not worked:
             raise InputError(
@@ -949,54 +936,6 @@ def _modal_forces(
                 fix="give a force the model can carry",
             )
     return loads, warnings
-
-
-def _superposed(
-    m: Modes,
-    zeta: np.ndarray,
-    loads: list[_Load],
-    t: np.ndarray,
-    derivatives: tuple[int, ...],
-    project: np.ndarray | None = None,
-) -> np.ndarray:
-    """The exact response of all loads superposed (:func:`modal_pwl_evaluate`).
-
-    ``derivatives`` of the modal coordinates, (len, k, nt), or of the rows ``project @ eta``
-    contracted block by block, (len, r, nt).
-    """
-    rows = m.n_modes if project is None else project.shape[0]
-    out = np.zeros((len(derivatives), rows, t.size))
-    for ld in loads:
-        f = ld.force
-        p = np.outer(ld.gamma, f.values)
-        out += modal_pwl_evaluate(
-            m.omega, zeta, f.timepts, p, t, derivatives=derivatives, project=project
-        )
-    return out
-
-
-def _modal_acceleration(
-    m: Modes, zeta: np.ndarray, loads: list[_Load], t: np.ndarray
-) -> np.ndarray:
-    """Modal accelerations (k, nt) of all loads superposed, m/s^2 per modal unit."""
-    return _superposed(m, zeta, loads, t, (2,))[0]
-
-
-def _modal_accel_at(
-    m: Modes, zeta: np.ndarray, loads: list[_Load], peaks: Sequence[PeakResponse]
-) -> np.ndarray:
-    """Modal accelerations (k, len(peaks)) at the exact peaks, in one evaluation.
-
-    At a jump on the peak's left side, the limit from the left (the time just before it).
-    """
-    tp = np.array([float(pk.peak_time_s) for pk in peaks])
-    left = np.array([pk.peak_side == "left" for pk in peaks], bool)
-    tp = np.where(left, np.nextafter(tp, -np.inf), tp)
-    order = np.argsort(tp, kind="stable")
-    acc = np.empty((m.n_modes, tp.size))
-    if tp.size:
-        acc[:, order] = _modal_acceleration(m, zeta, loads, tp[order])
-    return acc
 
 
 def _with_exact_peak(a: Assessment, peak: PeakResponse, req: Requirement) -> Assessment:
@@ -1355,33 +1294,31 @@ def _transient(
     warnings += w
     step("response")
     t = np.arange(0.0, opts.duration_s + 0.5 * opts.dt_s, opts.dt_s)
-    acc = _modal_acceleration(m, zeta, loads, t)
-    step("assessment")
-    mode_numbers = idx + 1
-    modal = _ModalSeries(t, acc)
+    names = list(maps)
     # every point's rows in one product per series (one GEMM, not one per point)
     rows = [tmap @ m.phi for tmap in maps.values()]
     tphi_all = np.concatenate(rows) if rows else np.zeros((0, m.n_modes))
-    # displacements and velocities at the points only (the modal ones are never stored)
-    d_all, v_all = _superposed(m, zeta, loads, t, (0, 1), tphi_all)
-    a_all = tphi_all @ acc
-    loads_b = [(ld.force, ld.b) for ld in loads]
-    peaks = peak_response(m.omega, zeta, m.phi, maps, loads_b, t, grid_accel=a_all)
-    acc_at_peaks = _modal_accel_at(m, zeta, loads, [peaks[name] for name in maps])
+    sup = superpose(m.omega, zeta, loads, t, names, tphi_all)
+    step("assessment")
+    mode_numbers = idx + 1
+    modal = _ModalSeries(t, sup.modal_accel)
 
     def observe(j: int, name: str) -> Observation:
         r = slice(3 * j, 3 * j + 3)
         tphi = tphi_all[r]
-        resp = PointResponse(name, t, d_all[r], v_all[r], a_all[r])
-        a = _with_exact_peak(assess(t, resp.acceleration, req), peaks[name], req)
+        resp = sup.points[name]
+        peak = sup.peaks[name]
+        a = _with_exact_peak(assess(t, resp.acceleration, req), peak, req)
         return Observation(
             name=name,
             response=resp,
             assessment=a,
             isolation=IsolationAdvice.not_assessed(name),
-            contributions=_contributions(mode_numbers, m, tphi, modal, a, acc_at_peaks[:, j]),
+            contributions=_contributions(
+                mode_numbers, m, tphi, modal, a, sup.modal_accel_at_peak[:, j]
+            ),
             interval=_intervals(t, resp.acceleration, req),
-            peak=peaks[name],
+            peak=peak,
         )
 
     def isolate(ob: Observation) -> Observation:
@@ -1395,7 +1332,7 @@ def _transient(
         )
         return replace(ob, isolation=adv)
 
-    obs = [observe(j, name) for j, name in enumerate(maps)]
+    obs = [observe(j, name) for j, name in enumerate(names)]
     step("isolation")
     if opts.isolation:
         obs = [isolate(ob) for ob in obs]
