@@ -493,14 +493,14 @@ def test_provenance_hash_of_a_file_read_in_blocks(tmp_path) -> None:
     # piece) is hashed by the library in blocks, in a background thread
     import hashlib
 
-    from microg.analysis import _Provenance
+    from microg.analysis.provenance import Provenance
 
     class FileModel:
         source = str(tmp_path / "big.bin")
 
     data = np.random.default_rng(0).bytes((1 << 23) + 12345)
     (tmp_path / "big.bin").write_bytes(data)
-    meta = _Provenance(FileModel(), "microg analyze big.bin").result()
+    meta = Provenance(FileModel(), "microg analyze big.bin").result()
     assert meta["model_sha256"] == hashlib.sha256(data).hexdigest()
     assert meta["model_path"] == str((tmp_path / "big.bin").resolve())
     assert meta["command"] == "microg analyze big.bin"
