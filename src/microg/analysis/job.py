@@ -195,7 +195,7 @@ def analyze(
         w = "direction" if len(dirs) == 1 else f"direction[{i}]"
         d = parse_direction(dirs[i if len(dirs) == nf else 0], w)
         dists.append(Disturbance(f, at_list[i if len(at_list) == nf else 0], d))
-    if not (isinstance(damping, int | float) and 0.0 <= float(damping) < 1.0):
+    if not isinstance(damping, int | float):  # its range: _check_options, with the others
         raise InputError(f"must be 0 <= zeta < 1, got {damping!r}", where="damping")
     pm = (
         DEFAULTS["package_mass_kg"]
@@ -234,7 +234,13 @@ def analyze(
     )
 
 
-def _check_record(opts: AnalysisOptions) -> None:
+def _check_options(opts: AnalysisOptions) -> None:
+    """Refuse options that make no verdict: the one check of the damping, record and bands.
+
+    The damping ratio is checked here once; the response kernels below trust it.
+    """
+    if not 0.0 <= opts.zeta < 1.0:
+        raise InputError(f"must be 0 <= zeta < 1, got {opts.zeta!r}", where="damping")
     if not opts.duration_s > 0:
         raise InputError(
             f"must be > 0, got {opts.duration_s:g} s",
@@ -308,7 +314,7 @@ def run_analysis(
         Called with a :class:`ModesReady` once the modes are solved, before the response.
     """
     step = progress or (lambda _s: None)
-    _check_record(opts)
+    _check_options(opts)
     req = requirement or requirement_object(opts.requirement)
     step("structure")
     structure = _structure(model, opts)

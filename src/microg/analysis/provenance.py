@@ -78,7 +78,7 @@ def provenance_record(model: Any, command: str | None) -> dict[str, Any]:
                 name = Path(src).name
                 data = resources.files("microg").joinpath("data").joinpath(name).read_bytes()
                 sha = hashlib.sha256(data).hexdigest()
-            except (OSError, FileNotFoundError, ValueError):
+            except (OSError, ValueError):  # FileNotFoundError is an OSError
                 sha = None
     return {
         "microg_version": __version__,

@@ -249,7 +249,7 @@ class Analysis:
             },
             attrs={
                 "model": self.model,
-                "requirement": str(getattr(self.requirement, "name", "")),
+                "requirement": self.requirement.name,
                 "warnings": "\n".join(self.warnings),
             },
         )
