@@ -641,6 +641,11 @@ def test_modal_pwl_evaluate_selects_and_projects_what_modal_pwl_response_gives()
     sel = modal_pwl_evaluate(omega, zeta, tf, p, t, derivatives=(2, 0))
     np.testing.assert_array_equal(sel[0], full.eta_ddot)
     np.testing.assert_array_equal(sel[1], full.eta)
+    # any order, repeats included (the kernel evaluates 0, 1, 2 once each, in order)
+    for qs in [(0, 2, 1), (1, 0), (2, 1, 0), (1, 1, 2)]:
+        got = modal_pwl_evaluate(omega, zeta, tf, p, t, derivatives=qs)
+        ref_q = np.stack([(full.eta, full.eta_dot, full.eta_ddot)[q] for q in qs])
+        np.testing.assert_array_equal(got, ref_q)
     proj = rng.standard_normal((3, 4))
     pr = modal_pwl_evaluate(omega, zeta, tf, p, t, derivatives=(1,), project=proj)[0]
     ref = proj @ full.eta_dot

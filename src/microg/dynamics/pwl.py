@@ -462,6 +462,17 @@ def evaluate(
     time), so the (len(qs), m, nt) modal array is never built.  Uniform runs take the table path
     (:func:`_table_run`), everything else the direct closed form; zero before the first
     breakpoint.
+
+    Parameters
+    ----------
+    st : the modal state of the force (:func:`prepare`)
+    t : (nt,) sorted output times, s
+    qs : derivatives wanted, each 0 (eta), 1 (eta') or 2 (eta''), in increasing order
+    project : (r, m) rows to contract the modes with (e.g. ``T phi``, m per modal unit)
+
+    Returns
+    -------
+    ndarray in the modal unit (times the projection's) per s^d.
     """
     m, nt, nq = st.omega.size, t.size, len(qs)
     rows = m if project is None else project.shape[0]

@@ -254,7 +254,8 @@ def modal_pwl_evaluate(
     omega, zeta, timepts_force, modal_force, timepts_out
         As :func:`modal_pwl_response` (rad/s, -, s, modal force, s).
     derivatives : sequence of int
-        Time derivatives wanted, each 0 (eta), 1 (eta') or 2 (eta'').
+        Time derivatives wanted, each 0 (eta), 1 (eta') or 2 (eta''), in any order (each is
+        evaluated once).
     project : ndarray (r, m), optional
         Rows to contract the modes with (e.g. points' ``T phi``, m per modal unit).
 
@@ -276,7 +277,9 @@ def modal_pwl_evaluate(
                 f"project must have shape (r, {omega.size}), got {project.shape}", where="project"
             )
     st = prepare(omega, zeta, timepts_force, modal_force)
-    return evaluate(st, timepts_out, qs, project)
+    wanted = tuple(sorted(set(qs)))  # the kernel takes distinct derivatives in increasing order
+    out = evaluate(st, timepts_out, wanted, project)
+    return out if wanted == qs else out[[wanted.index(d) for d in qs]]
 
 
 def generalized_force_vector(translation_map: np.ndarray, direction: np.ndarray) -> np.ndarray:
