@@ -35,6 +35,7 @@ from importlib import resources
 
 import numpy as np
 
+from microg.dynamics import bandquad
 from microg.dynamics import frequency as fq
 from microg.dynamics.modes import solve_modes
 from microg.environment.requirements import iss_requirement
@@ -170,7 +171,7 @@ def main() -> None:
     scale = np.max(np.abs(out), axis=0) * np.max(
         np.abs(inp[[i for i, ld in enumerate(loads) if ld in spec_loads]]), axis=0
     )
-    quad, _, _, _ = fq._converged_quadrature(
+    quad, _, _, _ = bandquad.converged_quadrature(
         bands.lower_hz,
         bands.upper_hz,
         m.omega,

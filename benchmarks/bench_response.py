@@ -44,7 +44,7 @@ from scipy import signal
 from scipy.linalg import block_diag
 from threadpoolctl import threadpool_limits
 
-from microg.dynamics import response as resp
+from microg.dynamics import pwl
 from microg.dynamics.forces import crew_pushoff, piecewise_linear
 from microg.dynamics.response import modal_pwl_response, peak_response, response_at_points
 
@@ -209,15 +209,15 @@ def main() -> None:
                 print(f"  {label}: microg vs numba recurrence, max difference {err:.1e} of peak")
             rows.append((f"modal_pwl_response, {label} ({grid.size} times)", t_k, t_nb))
             if label == "piecewise-uniform":  # the same grid without the table path
-                saved = resp._MIN_RUN
-                resp._MIN_RUN = 10**12
+                saved = pwl._MIN_RUN
+                pwl._MIN_RUN = 10**12
                 try:
                     t_d, _ = best_of(
                         lambda g=grid: modal_pwl_response(omega, zeta, force.timepts, mf, g),
                         repeat=3,
                     )
                 finally:
-                    resp._MIN_RUN = saved
+                    pwl._MIN_RUN = saved
                 rows.append(("  same grid, direct closed form only (no tables)", t_d, t_nb))
             if f_ is off_jump:
                 continue  # the same memory as the uniform grid

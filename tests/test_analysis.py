@@ -488,19 +488,33 @@ def test_a_negative_duration_is_blamed_on_the_duration():
     assert err.value.where == "duration" and "must be > 0" in str(err.value)
 
 
+@pytest.mark.parametrize("zeta", [1.0, -0.01, float("nan")])
+def test_damping_outside_0_1_is_refused_once_at_the_boundary(station, zeta) -> None:
+    """The damping ratio is checked once, for analyze() and run_analysis() alike (the response
+    kernels trust it): a ratio of 1 or more, a negative one or NaN names the damping."""
+    import microg
+
+    with pytest.raises(microg.InputError) as err:
+        run_analysis(station, _opts(zeta=zeta))
+    assert err.value.where == "damping" and "0 <= zeta < 1" in str(err.value)
+    with pytest.raises(microg.InputError) as err:
+        microg.analyze(station, damping=zeta)
+    assert err.value.where == "damping"
+
+
 def test_provenance_hash_of_a_file_read_in_blocks(tmp_path) -> None:
     # reference: hashlib over the whole file at once; the file (> 8 MiB, one block and a
     # piece) is hashed by the library in blocks, in a background thread
     import hashlib
 
-    from microg.analysis import _Provenance
+    from microg.analysis.provenance import Provenance
 
     class FileModel:
         source = str(tmp_path / "big.bin")
 
     data = np.random.default_rng(0).bytes((1 << 23) + 12345)
     (tmp_path / "big.bin").write_bytes(data)
-    meta = _Provenance(FileModel(), "microg analyze big.bin").result()
+    meta = Provenance(FileModel(), "microg analyze big.bin").result()
     assert meta["model_sha256"] == hashlib.sha256(data).hexdigest()
     assert meta["model_path"] == str((tmp_path / "big.bin").resolve())
     assert meta["command"] == "microg analyze big.bin"

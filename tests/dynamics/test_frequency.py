@@ -19,6 +19,7 @@ from hypothesis import strategies as st
 from scipy.integrate import quad
 
 from microg._io import dumps
+from microg.dynamics import bandquad
 from microg.dynamics import frequency as fq
 from microg.dynamics.modes import solve_modes
 from microg.errors import InputError
@@ -241,10 +242,10 @@ def test_near_far_split_equals_the_full_modal_sum_on_the_same_nodes(fem):
     out = fq.output_modal(m, ["lab", "boom-tip"])
     inp = np.array([fq.input_modal(m, ld.at, ld.direction) for ld in loads])
     scale = np.max(np.abs(out), axis=0) * np.max(np.abs(inp), axis=0)
-    quad_, _, _, _ = fq._converged_quadrature(lo, hi, m.omega, z, scale, specs, 8, 1e-9)
+    quad_, _, _, _ = bandquad.converged_quadrature(lo, hi, m.omega, z, scale, specs, 8, 1e-9)
     h = fq.acceleration_frf(m.omega, z, out, inp, 2 * np.pi * quad_.freq_hz)  # all modes
     S = np.array([sp.psd_at(quad_.freq_hz) for sp in specs])
-    ref = fq._per_band(np.abs(h) ** 2 * S[None] * quad_.weight_hz, quad_.start)  # (p, s, nb)
+    ref = bandquad.per_band(np.abs(h) ** 2 * S[None] * quad_.weight_hz, quad_.start)  # (p, s, nb)
     got = np.moveaxis(r.source_rms_mps2.reshape(6, lo.size, 2), 2, 1) ** 2
     assert np.any(r.near_modes < m.n_modes)  # the far-mode path is exercised
     # far-mode interpolants are checked to 1e-14 of each mode: 1e-11 relative

@@ -229,28 +229,3 @@ def test_peak_property_against_dense_polished_expm(omega, zeta, times, vals, jum
     # 1e5 dense points over <= 8 s (8e-5 s apart), polished
     refs, ref = _reference_peaks(omega, zeta_a, phi, maps, force, b, (t[0], t[-1]), 100_001)
     _check(pk, refs, ref, phi, maps)
-
-
-def test_caller_grid_accelerations_give_the_same_peaks_and_a_wrong_grid_is_refused():
-    """grid_accel (the caller's samples, here response_at_points') changes nothing; a grid
-    that is not the closed form (scaled by 1 + 1e-6, above the 1e-9 check) is refused."""
-    rng = np.random.default_rng(5)
-    omega = np.r_[0.0, 1.1, 3.7]
-    zeta = np.r_[0.0, 0.01, 0.02]
-    phi, maps, b = _model(rng, omega)
-    force = crew_pushoff(60.0, 0.9, 4.31, 5.2)
-    t = np.arange(0.0, 9.0, 0.05)
-    own = peak_response(omega, zeta, phi, maps, [(force, b)], t)
-    resp = response_at_points(omega, zeta, phi, maps, force, b, t)
-    grid = np.concatenate([resp[name].acceleration for name in maps])
-    given_grid = peak_response(omega, zeta, phi, maps, [(force, b)], t, grid_accel=grid)
-    for name in maps:
-        # the same closed form evaluated by two paths: rounding, 1e-12 of the peak
-        assert given_grid[name].peak_accel_mps2 == pytest.approx(
-            own[name].peak_accel_mps2, rel=1e-12
-        )
-        assert given_grid[name].upper_bound_mps2 >= given_grid[name].peak_accel_mps2
-    with pytest.raises(ValueError, match="closed-form"):
-        peak_response(omega, zeta, phi, maps, [(force, b)], t, grid_accel=grid * (1 + 1e-6))
-    with pytest.raises(ValueError, match="shape"):
-        peak_response(omega, zeta, phi, maps, [(force, b)], t, grid_accel=grid[:, :-1])

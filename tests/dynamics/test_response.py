@@ -18,6 +18,7 @@ from scipy import signal
 from scipy.integrate import solve_ivp
 from scipy.linalg import eigh
 
+from microg.dynamics import pwl
 from microg.dynamics import response as resp
 from microg.dynamics.forces import crew_pushoff, piecewise_linear
 from microg.dynamics.response import (
@@ -190,9 +191,9 @@ def test_table_and_direct_paths_agree(monkeypatch, n_breaks):
     tout = np.linspace(-1, 45, 4001)
     mf = np.outer(rng.normal(size=OMEGA.size), fb)
     default = modal_pwl_response(OMEGA, ZETA, tb, mf, tout)
-    monkeypatch.setattr(resp, "_MIN_RUN", 10**9)  # everything direct
+    monkeypatch.setattr(pwl, "_MIN_RUN", 10**9)  # everything direct
     direct = modal_pwl_response(OMEGA, ZETA, tb, mf, tout)
-    monkeypatch.setattr(resp, "_MIN_RUN", 2)  # every run of 2 or more times by tables
+    monkeypatch.setattr(pwl, "_MIN_RUN", 2)  # every run of 2 or more times by tables
     tables = modal_pwl_response(OMEGA, ZETA, tb, mf, tout)
     for a in ("eta", "eta_dot", "eta_ddot"):
         ref = getattr(direct, a)
@@ -208,10 +209,10 @@ def test_piecewise_uniform_grid_keeps_the_table_path():
     f = crew_pushoff(t13=13.000000001, t14=14.000000001)
     # two uniform pieces (dt 0.01 then 0.05), the off-grid jump time inserted, one stray time
     t = np.unique(np.r_[np.linspace(0, 20, 2001), np.linspace(20, 100, 1601), 13.000000001, 57.3])
-    runs, rest = resp._runs(t, np.unique(f.timepts))
+    runs, rest = pwl._runs(t, np.unique(f.timepts))
     covered = sum(i1 - i0 for _, i0, i1 in runs)
     # all but a handful of times (those next to the force breakpoints and the stray ones)
-    assert covered >= t.size - 2 * resp._MIN_RUN
+    assert covered >= t.size - 2 * pwl._MIN_RUN
     assert {round(float(np.diff(t[i0:i1]).mean()), 6) for _, i0, i1 in runs} == {0.01, 0.05}
     mf = np.tile(f.force, (OMEGA.size, 1))
     r = modal_pwl_response(OMEGA, ZETA, f.timepts, mf, t)
@@ -608,12 +609,12 @@ def test_piecewise_uniform_runs_equal_direct_evaluation_at_every_time(monkeypatc
     )
     rng = np.random.default_rng(11)
     mf = np.outer(rng.normal(size=OMEGA.size), fb)
-    runs, rest = resp._runs(t, np.unique(tb))
+    runs, rest = pwl._runs(t, np.unique(tb))
     assert len(runs) >= 6 and rest.size <= 8  # the table path covers each piece
     tables = modal_pwl_response(OMEGA, ZETA, tb, mf, t)
-    monkeypatch.setattr(resp, "_MIN_RUN", 10**9)  # every time by the direct closed form
+    monkeypatch.setattr(pwl, "_MIN_RUN", 10**9)  # every time by the direct closed form
     direct = modal_pwl_response(OMEGA, ZETA, tb, mf, t)
-    assert resp._runs(t, np.unique(tb))[0] == []
+    assert pwl._runs(t, np.unique(tb))[0] == []
     for a in ("eta", "eta_dot", "eta_ddot"):
         ref = getattr(direct, a)
         scale = np.max(np.abs(ref), axis=1, keepdims=True)
@@ -640,6 +641,11 @@ def test_modal_pwl_evaluate_selects_and_projects_what_modal_pwl_response_gives()
     sel = modal_pwl_evaluate(omega, zeta, tf, p, t, derivatives=(2, 0))
     np.testing.assert_array_equal(sel[0], full.eta_ddot)
     np.testing.assert_array_equal(sel[1], full.eta)
+    # any order, repeats included (the kernel evaluates 0, 1, 2 once each, in order)
+    for qs in [(0, 2, 1), (1, 0), (2, 1, 0), (1, 1, 2)]:
+        got = modal_pwl_evaluate(omega, zeta, tf, p, t, derivatives=qs)
+        ref_q = np.stack([(full.eta, full.eta_dot, full.eta_ddot)[q] for q in qs])
+        np.testing.assert_array_equal(got, ref_q)
     proj = rng.standard_normal((3, 4))
     pr = modal_pwl_evaluate(omega, zeta, tf, p, t, derivatives=(1,), project=proj)[0]
     ref = proj @ full.eta_dot

@@ -1,4 +1,4 @@
-"""The factored exponential tables of the response kernel (microg.dynamics.response._exp_table).
+"""The factored exponential tables of the response kernel (microg.dynamics.oscillator.exp_table).
 
 Reference: numpy's direct complex exponential of the same arguments, exp(lam (t0 + i step)).
 """
@@ -9,7 +9,7 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from microg.dynamics import response as resp
+from microg.dynamics import oscillator
 
 EPS = np.finfo(float).eps
 
@@ -24,11 +24,11 @@ EPS = np.finfo(float).eps
 )
 def test_exp_table_equals_direct_exponentials(sigma, omega_d, t0, step, count):
     lam = np.array([[-sigma + 1j * omega_d], [-0.5 * sigma + 0.3j * omega_d], [0.0 + 0j]])
-    got = resp._exp_table(lam, t0, step, count)
+    got = oscillator.exp_table(lam, t0, step, count)
     times = t0 + np.arange(count) * step
     arg = lam * times
     ref = np.exp(arg)
-    decayed = arg.real < -resp._DECAYED
+    decayed = arg.real < -oscillator.DECAYED
     # set to exactly 0 below exp(-600) (the kernel's convention: 1e-261 of the start)
     assert np.all(got[decayed] == 0.0)
     # never a subnormal number (they make the kernel's arithmetic ~100x slower)

@@ -81,7 +81,7 @@ def test_modal_mass_from_sample_peaks_equals_the_dense_displacements():
 
 
 def test_contributions_equal_each_modes_own_series():
-    from microg.analysis import _modal_forces
+    from microg.analysis.transient import modal_loads
     from microg.dynamics.response import modal_pwl_response
 
     model = _model(400, 16, seed=3)
@@ -99,7 +99,7 @@ def test_contributions_equal_each_modes_own_series():
     idx = np.flatnonzero(res.used)
     m = res.modes.subset(idx)
     zeta = np.where(m.rigid, 0.0, opts.zeta)
-    loads, _ = _modal_forces(st, m, opts)
+    loads, _ = modal_loads(st, m, opts)
     t = res.timepts
     # reference: the full modal response of each load (modal_pwl_response), superposed
     eta = np.zeros((m.n_modes, t.size))

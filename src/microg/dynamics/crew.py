@@ -116,11 +116,6 @@ class CrewPushoff:
                 exc.what.replace(" t1 (", " --t1 ("), where=where, fix=exc.fix
             ) from None
 
-    @property
-    def impulse_pushoff(self) -> float:
-        """Impulse of the push-off ramp, f0 t1 / 2, N s (Eq. 2.32)."""
-        return 0.5 * self.f0 * self.t1
-
     def breakpoints(self) -> tuple[np.ndarray, np.ndarray]:
         """Piecewise-linear breakpoints (times s, force N); a repeated time is a jump."""
         t = np.array([0.0, self.t1, self.t1, self.t13, self.t13, self.t14])
