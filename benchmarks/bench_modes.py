@@ -18,8 +18,8 @@ with 1 and 2 BLAS threads (threadpoolctl):
 
 Every baseline has ARPACK's default basis (``ncv = 2k + 1``), a negative shift
 ``sigma = -1e-12 max(K_ii/M_ii)``, nothing deflated and nothing checked; the ratio printed is
-microg's time over the fastest baseline.  (microg picks its own BLAS thread count inside
-``solve_modes``; the thread setting applies to the baselines, and is the ceiling for microg.)
+microg's time over the fastest baseline.  (The thread setting applies to microg and the
+baselines alike: microg's library calls never change it.)
 Run: ``.venv/bin/python benchmarks/bench_modes.py`` (the 103k-DOF model, 30 modes, one
 thread: under a minute); the full table is
 ``.venv/bin/python benchmarks/bench_modes.py --modes 30 300 --threads 1 2`` (about 15 minutes

@@ -26,7 +26,6 @@ STAGES: dict[str, int] = {
     "_io": 0,
     "_vectors": 0,
     "_scan": 0,
-    "_fork": 0,
     "models": 1,
     "structure": 2,
     "dynamics": 3,
@@ -155,8 +154,8 @@ def test_import_microg_is_light(heavy: str) -> None:
 
 @pytest.mark.parametrize("heavy", ["scipy", "pydantic", "pint", "matplotlib"])
 def test_the_classes_of_an_analysis_import_light(heavy: str) -> None:
-    # the figure helper of ``microg analyze`` unpickles an Analysis of a frame model with
-    # these modules only (microg.report.render): scipy and pydantic load on first use
+    # the result classes and the report module import lazily: scipy and pydantic load on
+    # first use (a reader of a pickled Analysis of a frame model needs none of them)
     mods = "microg.analysis, microg.structure.fem, microg.report.analysis"
     code = f"import sys, {mods}; print({heavy!r} in sys.modules)"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)

@@ -29,22 +29,3 @@ def test_indexed_parameters_keep_their_index():
     with pytest.raises(InputError) as err, flag_errors({"force": "--force"}):
         raise InputError("bad", where="force[1]")
     assert err.value.where == "--force (force[1])" and err.value.fix is None
-
-
-def test_main_as_the_process_freezes_the_heap_and_a_call_with_argv_does_not(monkeypatch, capsys):
-    """main() (the script) ends with gc.freeze (no final collections at exit); main(argv)
-    (a caller in Python, such as these tests) leaves the collector alone."""
-    import gc
-
-    from microg.cli import main
-
-    gc.unfreeze()
-    assert main(["--version"]) == 0
-    assert gc.get_freeze_count() == 0
-    monkeypatch.setattr("sys.argv", ["microg", "--version"])
-    try:
-        assert main() == 0
-        assert gc.get_freeze_count() > 0
-    finally:
-        gc.unfreeze()
-    capsys.readouterr()

@@ -2,11 +2,6 @@
 
 from __future__ import annotations
 
-import json
-import os
-import subprocess
-import sys
-
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -134,39 +129,3 @@ def test_modes_api_elastic_fraction_dict_xarray_plot() -> None:
 
     fig = modes.plot()
     assert isinstance(fig, Figure) and fig.axes[0].get_yscale() == "log"
-
-
-def test_blas_threads_limit_small_problems() -> None:
-    # small dense problems run on one BLAS thread (2 threads cost 100x on this machine)
-    from threadpoolctl import threadpool_info
-
-    from microg.dynamics.dense import blas_threads
-
-    with blas_threads(100):
-        assert all(i["num_threads"] == 1 for i in threadpool_info() if i["user_api"] == "blas")
-
-
-def test_blas_threads_limit_scipys_blas_loaded_after_the_first_limit() -> None:
-    # scipy loads on first use (import microg.analysis does not load it), with its own
-    # OpenBLAS: a limit set before it loaded must still reach it once it has (a fresh
-    # interpreter; reference: threadpoolctl's report of every BLAS library's threads)
-    code = (
-        "import json, sys\n"
-        "from microg.dynamics.dense import blas_threads\n"
-        "with blas_threads(100):\n"
-        "    pass\n"
-        "assert 'scipy.linalg' not in sys.modules\n"
-        "import scipy.linalg\n"
-        "from threadpoolctl import threadpool_info\n"
-        "with blas_threads(100):\n"
-        "    inside = [(i['filepath'], i['num_threads']) for i in threadpool_info()\n"
-        "              if i['user_api'] == 'blas']\n"
-        "print(json.dumps(inside))\n"
-    )
-    env = {k: v for k, v in os.environ.items() if not k.endswith("_NUM_THREADS")}
-    env.pop("MICROG_BLAS_CORES", None)
-    out = subprocess.run(
-        [sys.executable, "-c", code], capture_output=True, text=True, env=env, check=True
-    )
-    inside = json.loads(out.stdout)
-    assert len(inside) >= 1 and all(n == 1 for _, n in inside), inside

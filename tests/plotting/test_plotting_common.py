@@ -1,33 +1,34 @@
-"""The lean figure machinery of microg.plotting.common (issue 8, "Speed of the main job").
+"""What every figure shares (microg.plotting.common), and figures drawn where the caller says.
 
 References: a brute-force slice-by-slice min/max for the drawing envelope; matplotlib's own
-LogFormatterSciNotation labels for the Unicode log labels; matplotlib's own Axis objects (the
-same figure drawn both ways) for the lean axes; matplotlib's PNG writer and PIL's decoder for
-the PNG encoder; matplotlib's measured text extents for the fixed margins.
+objects (the caller's axes, their visible axis, their tick labels' size after
+``tick_params``, ``Figure.savefig``'s PNG file) for the drawing into a caller's axes;
+matplotlib's measured text extents for the layout of the report's figures.
 """
 
 from __future__ import annotations
 
+import inspect
 import io
 
+import matplotlib.pyplot as plt
 import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 from matplotlib.figure import Figure
-from matplotlib.ticker import LogFormatterSciNotation
 from PIL import Image
 
-from microg.plotting.common import (
-    PlainLogFormatter,
-    encode_png,
-    envelope,
-    finish,
-    new_figure,
-    plain_axes,
-    png_bytes,
-)
+from microg.errors import InputError
+from microg.plotting.common import envelope, figure_axes, figure_grid, png_bytes
+
+
+@pytest.fixture(scope="module")
+def result():
+    import microg
+
+    return microg.analyze("ioc", observe=["lab"], duration=40, dt=0.02)
 
 
 def _brute_envelope_values(y: np.ndarray, bins: int) -> list[tuple[float, float]]:
@@ -74,192 +75,126 @@ def test_envelope_property_extremes_kept(y):
     assert np.array_equal(y[xe.astype(int)], ye)
 
 
-@pytest.mark.parametrize(
-    ("value", "expected"),
-    [
-        (1e-5, "10\u207b\u2075"),
-        (1.0, "10\u2070"),
-        (1e3, "10\u00b3"),
-        (1e-12, "10\u207b\u00b9\u00b2"),
-    ],
-)
-def test_log_labels_are_matplotlibs_in_unicode(value, expected):
-    # reference: matplotlib's mathtext label for the same tick, $\mathdefault{10^{k}}$
-    fig = Figure()
-    ax = fig.add_subplot()
-    ax.loglog([1e-13, 1e4], [1.0, 2.0])
-    ours, theirs = PlainLogFormatter(), LogFormatterSciNotation()
-    for f in (ours, theirs):
-        f.set_axis(ax.xaxis)
-        f.set_locs([value])
-    exponent = round(np.log10(value))
-    assert theirs(value) == rf"$\mathdefault{{10^{{{exponent}}}}}$"
-    assert ours(value) == expected
+def test_an_observation_draws_into_the_callers_axes(result):
+    # reference: the caller's own pyplot figure and axes, and matplotlib's own Axis objects
+    ob = result.observations["lab"]
+    fig, ax = plt.subplots()
+    try:
+        out = ob.plot(ax=ax)
+        assert out is fig  # the caller's figure, not a new one
+        assert len(fig.axes) == 1 and ax.get_lines()  # drawn into that axes, nothing added
+        assert ax.get_title().startswith("Acceleration at lab")
+        assert ax.xaxis.get_visible() and ax.yaxis.get_visible()  # matplotlib's axes, shown
+        ax.tick_params(labelsize=5)
+        fig.canvas.draw()
+        sizes = {t.get_fontsize() for t in ax.get_xticklabels() + ax.get_yticklabels()}
+        assert sizes == {5.0}  # tick_params takes effect on the labels drawn
+        ob.plot(ax=ax, kind="bands")  # a second panel's kind into another caller axes
+        assert ax.get_xscale() == "log"
+    finally:
+        plt.close(fig)
 
 
-def test_log_labels_non_decade():
-    # reference: matplotlib's mathtext labels on a narrow log axis (labelled between decades)
-    fig = Figure()
-    ax = fig.add_subplot()
-    ax.loglog([1.0, 5.0], [1.0, 2.0])
-    values = [2.0, 3.0, 30.0, 0.02]
-    ours, theirs = (
-        PlainLogFormatter(labelOnlyBase=False),
-        LogFormatterSciNotation(labelOnlyBase=False),
+def test_a_two_panel_figure_draws_into_two_caller_axes(result):
+    ob = result.observations["lab"]
+    fig, (top, bottom) = plt.subplots(2, 1)
+    try:
+        assert ob.plot(ax=[top, bottom]) is fig
+        assert top.get_xscale() == "linear" and bottom.get_xscale() == "log"
+        assert len(fig.axes) == 2
+        with pytest.raises(InputError, match="ax"):
+            ob.plot(ax=[top, bottom, top])  # three axes for two panels
+        with pytest.raises(InputError, match="kind"):
+            ob.plot(kind="spectrum")
+    finally:
+        plt.close(fig)
+
+
+def test_without_axes_a_new_figure_is_made_and_saved_as_matplotlib_saves_it(result):
+    # reference: Figure.savefig's own PNG file of the same figure, decoded by PIL (pixel for
+    # pixel: the same drawing)
+    fig = result.observations["lab"].plot()
+    assert isinstance(fig, Figure) and len(fig.axes) == 2
+    assert fig.get_layout_engine() is not None  # matplotlib places the axes (constrained)
+    assert all(a.xaxis.get_visible() for a in fig.axes)
+    png = png_bytes(fig, dpi=60)
+    buf = io.BytesIO()  # the same figure made afresh (a layout engine's first draw), saved
+    result.observations["lab"].plot().savefig(buf, format="png", dpi=60)
+    ours = np.asarray(Image.open(io.BytesIO(png)))
+    theirs = np.asarray(Image.open(io.BytesIO(buf.getvalue())))
+    assert ours.shape == theirs.shape and np.array_equal(ours, theirs)
+
+
+def test_every_plot_function_takes_ax():
+    # reference: the signatures of the public plot functions of every figure module
+    import importlib
+
+    names = ["analysis", "environment", "frequency", "intervals", "isolation", "location"]
+    names += ["modes", "quasisteady", "seed", "study"]
+    missing = []
+    for name in names:
+        mod = importlib.import_module(f"microg.plotting.{name}")
+        for fn_name in mod.__all__:
+            fn = getattr(mod, fn_name)
+            if fn_name in ("limit_steps", "live_axes", "sample_displacements", "write_png_atomic"):
+                continue  # not figures
+            if "ax" not in inspect.signature(fn).parameters:
+                missing.append(f"{name}.{fn_name}")
+    assert missing == []
+
+
+def test_figure_helpers_check_the_callers_axes():
+    fig, ax = figure_axes(None, 4.0, 3.0)
+    assert tuple(fig.get_size_inches()) == (4.0, 3.0) and fig.axes == [ax]
+    assert figure_axes(ax)[0] is fig  # the caller's axes: their figure, unchanged
+    with pytest.raises(InputError, match="ax"):
+        figure_axes("not an axes")  # type: ignore[arg-type]
+    fig2, grid = figure_grid(None, 2, 3)
+    assert grid.shape == (2, 3) and len(fig2.axes) == 6
+    assert figure_grid(list(grid.ravel()), 3, 2)[1].shape == (3, 2)  # read row by row
+    with pytest.raises(InputError, match="6 matplotlib Axes"):
+        figure_grid(list(grid.ravel())[:5], 2, 3)
+    sub = Figure().subfigures(1, 2)[0].add_subplot()
+    assert isinstance(figure_axes(sub)[0], Figure)  # a subfigure's axes: the root figure
+
+
+def test_line2d_set_is_matplotlibs_own(tmp_path):
+    # reference: Line2D.set's signature and docstring in a plain interpreter; the other
+    # interpreter runs ``microg analyze`` first (matplotlib imported by microg), then reads them
+    import json
+    import subprocess
+    import sys
+
+    read = (
+        "import inspect, json, matplotlib.lines as ml\n"
+        "print(json.dumps([str(inspect.signature(ml.Line2D.set)), ml.Line2D.set.__doc__]))\n"
     )
-    for f in (ours, theirs):
-        f.set_axis(ax.xaxis)
-        f.set_locs(values)
-    assert [theirs(v) for v in values] == [
-        r"$\mathdefault{2\times10^{0}}$",
-        r"$\mathdefault{3\times10^{0}}$",
-        r"$\mathdefault{3\times10^{1}}$",
-        r"$\mathdefault{2\times10^{-2}}$",
-    ]
-    assert [ours(v) for v in values] == [
-        "2\u00d710\u2070",
-        "3\u00d710\u2070",
-        "3\u00d710\u00b9",
-        "2\u00d710\u207b\u00b2",
-    ]
+    run = (
+        "import sys\n"
+        "from microg.cli import main\n"
+        f"assert main(['analyze', '--duration', '40', '--dt', '0.02', '--no-progress', "
+        f"'--out', {str(tmp_path / 'out')!r}]) == 0\n"
+        "assert 'matplotlib.lines' in sys.modules\n"
+    )
 
+    def py(code: str) -> list[str]:
+        out = subprocess.run(
+            [sys.executable, "-c", code], capture_output=True, text=True, check=True, timeout=300
+        )
+        return json.loads(out.stdout.strip().splitlines()[-1])
 
-def _pixels(fig: Figure) -> np.ndarray:
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=80)
-    return np.asarray(Image.open(io.BytesIO(buf.getvalue())).convert("RGB"), int)
-
-
-def _loglog_figure() -> Figure:
-    fig = new_figure(6.0, 4.0)
-    ax = fig.add_subplot()
-    f = np.logspace(-2, 2.5, 200)
-    ax.loglog(f, 1e-3 / (1 + f**2), lw=0.8, label="x")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.set_xlabel("frequency [Hz]")
-    ax.set_ylabel("PSD [g^2/Hz]")
-    ax.set_title("a log-log figure")
-    ax.legend()
-    return fig
-
-
-def _linear_figure() -> Figure:
-    fig = new_figure(6.0, 4.0)
-    ax = fig.add_subplot()
-    t = np.linspace(0.0, 200.0, 500)
-    ax.plot(t, 60.0 * np.sin(t / 7.0), lw=0.8, label="x")
-    ax.plot(t, -40.0 * np.cos(t / 3.0), lw=0.8, label="y")
-    ax.grid(True, alpha=0.3)
-    ax.set_xlabel("time [s]")
-    ax.set_ylabel("acceleration [micro-g]")
-    ax.set_title("a linear figure")
-    ax.legend(fontsize=8)
-    return fig
-
-
-def _narrow_log_and_offset_figure() -> Figure:
-    # minor log labels (less than 1.5 decades) above, an offset text ("1e5") below
-    fig = new_figure(6.0, 6.0)
-    ax1, ax2 = fig.subplots(2, 1)
-    ax1.loglog([1.0, 5.0], [2.0, 30.0], "o-")
-    ax1.grid(True, which="both", alpha=0.3)
-    ax1.set_xlabel("f [Hz]")
-    ax1.set_ylabel("rms")
-    t = np.linspace(0.0, 1.0, 50)
-    ax2.plot(t, 1e5 + t, label="drift")
-    ax2.set_xlabel("time [s]")
-    ax2.set_ylabel("counts")
-    ax2.set_title("an offset text")
-    return fig
-
-
-def _rotated_labels_figure() -> Figure:
-    # bars with fixed, slanted tick labels (as the source-contribution figure draws them)
-    fig = new_figure(6.0, 4.0, margins={"bottom": 1.0})
-    ax = fig.add_subplot()
-    x = np.arange(12)
-    ax.bar(x, np.linspace(0.1, 1.0, 12), label="pump")
-    ax.set_xticks(x[::3], [f"{c:.3g}" for c in np.logspace(-1, 1, 12)[::3]], rotation=60)
-    ax.set_xlabel("band centre [Hz]")
-    ax.grid(True, axis="y", alpha=0.3)
-    ax.legend(fontsize="small")
-    return fig
-
-
-def _matplotlibs(build):  # the same figure, finished, drawn by matplotlib's own Axis objects
-    return plain_axes(finish(build()))
-
-
-@pytest.mark.parametrize(
-    "build",
-    [_loglog_figure, _linear_figure, _narrow_log_and_offset_figure, _rotated_labels_figure],
-)
-def test_lean_axes_draw_as_matplotlibs(build):
-    # reference: the same figure drawn by matplotlib's own Axis (Tick objects), same margins
-    lean, plain = finish(build()), _matplotlibs(build)
-    assert not lean.axes[0].xaxis.get_visible()  # ours: the Axis is hidden, no Tick drawn
-    assert plain.axes[0].xaxis.get_visible()
-    ours, theirs = _pixels(lean), _pixels(plain)
-    assert ours.shape == theirs.shape
-    diff = np.abs(ours - theirs).max(axis=2)
-    # anti-aliasing of grid lines drawn by one collection rather than one Line2D per tick
-    # may differ by a grey level or two; no pixel may differ visibly, and text (tick labels,
-    # axis labels, offset text, title) lands on the same pixels
-    assert diff.max() <= 8, diff.max()
-    assert np.count_nonzero(diff) <= 1e-3 * diff.size
-
-
-def test_lean_axes_follow_later_changes():
-    # reference: matplotlib's own Axis after the same changes made after finish()
-    def changed(fig: Figure) -> Figure:
-        ax = fig.axes[0]
-        ax.set_xlim(0.1, 10.0)
-        ax.set_xticks([0.2, 1.0, 5.0])
-        ax.set_xlabel("new label")
-        return fig
-
-    ours = _pixels(changed(finish(_loglog_figure())))
-    theirs = _pixels(changed(_matplotlibs(_loglog_figure)))
-    diff = np.abs(ours - theirs).max(axis=2)
-    assert diff.max() <= 8 and np.count_nonzero(diff) <= 1e-3 * diff.size
-
-
-def test_png_bytes_are_matplotlibs_pixels():
-    # reference: matplotlib's own PNG writer (savefig), decoded by PIL, pixel for pixel
-    fig = finish(_linear_figure())
-    png = png_bytes(fig, dpi=80)
-    assert png[:8] == b"\x89PNG\r\n\x1a\n"
-    ours = np.asarray(Image.open(io.BytesIO(png)).convert("RGBA"), int)
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=80)
-    theirs = np.asarray(Image.open(io.BytesIO(buf.getvalue())).convert("RGBA"), int)
-    assert np.array_equal(ours, theirs)
-    assert fig.dpi == 100 and type(fig.canvas).__name__ == "FigureCanvasBase"  # left as found
-
-
-@given(
-    arrays(np.uint8, st.tuples(st.integers(1, 9), st.integers(1, 9), st.just(4))),
-    st.booleans(),
-    st.integers(0, 9),
-)
-def test_encode_png_round_trips(rgba, opaque, level):
-    # reference: PIL's PNG decoder; every pixel comes back (RGBA, or RGB when opaque)
-    if opaque:
-        rgba = rgba.copy()
-        rgba[:, :, 3] = 255
-    back = np.asarray(Image.open(io.BytesIO(encode_png(rgba, level))).convert("RGBA"))
-    assert np.array_equal(back, rgba)
-    assert Image.open(io.BytesIO(encode_png(rgba))).mode == ("RGB" if opaque else "RGBA")
+    plain, after = py(read), py(run + read)
+    assert after == plain
+    assert "linewidth" in plain[0] and len(plain[1]) > 1000  # the generated set() signature
 
 
 def test_report_figures_keep_every_label_inside():
     # reference: matplotlib's own text extents, measured after drawing
     import microg
-    from microg.report.analysis import figure_jobs
+    from microg.report.analysis import figure_builders
 
     result = microg.analyze("ioc", observe=["lab"], duration=40, dt=0.02, isolation=False)
-    jobs = figure_jobs(result)
-    assert [j.name for j in jobs] == [
+    assert list(figure_builders(result)) == [
         "model.png",
         "modes.png",
         "forces.png",

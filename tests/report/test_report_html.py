@@ -55,7 +55,7 @@ def test_analysis_report_is_the_same_from_the_cache(tmp_path, monkeypatch):
 
     assert environment().bytecode_cache is not None  # the package's templates are cached
     result = microg.analyze("ioc", observe=["lab"], duration=40, dt=0.02, isolation=False)
-    figs = {j.name: j.name.encode() for j in rep.figure_jobs(result)}  # nothing drawn
+    figs = {name: name.encode() for name in rep.figure_builders(result)}  # nothing drawn
     pages = []
     for cache in (None, _BytecodeCache(str(tmp_path)), _BytecodeCache(str(tmp_path))):
         env = environment()

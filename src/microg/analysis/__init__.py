@@ -23,7 +23,7 @@ record).
 from __future__ import annotations
 
 from microg.analysis.contributions import ModeContributions
-from microg.analysis.job import ModesReady, analyze, run_analysis
+from microg.analysis.job import analyze, run_analysis
 from microg.analysis.options import (
     DEFAULT_SOURCE_MODES,
     DEFAULTS,
@@ -46,7 +46,6 @@ __all__ = [
     "ModeContributions",
     "Observation",
     "Analysis",
-    "ModesReady",
     "analyze",
     "run_analysis",
 ]

@@ -9,7 +9,6 @@ vibratory sources, and returns one :class:`~microg.analysis.result.Analysis`.
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -38,40 +37,13 @@ from microg.analysis.options import (
 from microg.analysis.provenance import Provenance
 from microg.analysis.result import Analysis, Observation
 from microg.analysis.transient import check_modes_used, transient
-from microg.dynamics.dense import blas_threads
-from microg.dynamics.modes import DEFAULT_N_MODES, Modes, solve_modes
+from microg.dynamics.modes import DEFAULT_N_MODES, solve_modes
 from microg.environment.requirements import Requirement
 from microg.errors import InputError
 from microg.structure.discretize import discretize
 from microg.structure.structure import Structure
 
-__all__ = ["ModesReady", "analyze", "run_analysis"]
-
-
-@dataclass(frozen=True)
-class ModesReady:
-    """The main job part-way: the structure and its modes, before any response.
-
-    What :func:`run_analysis` hands its ``on_modes`` callback as soon as the modes are
-    solved; the same values become the :class:`Analysis`'s fields of these names.
-
-    Attributes
-    ----------
-    model : str
-        Model name.
-    options : AnalysisOptions
-    structure : Structure
-    modes : Modes
-    used : ndarray of bool
-        Modes that enter the response (rigid-body modes and elastic ones up to
-        ``options.max_freq_hz``).
-    """
-
-    model: str
-    options: AnalysisOptions
-    structure: Structure
-    modes: Modes
-    used: np.ndarray
+__all__ = ["analyze", "run_analysis"]
 
 
 def analyze(
@@ -97,7 +69,6 @@ def analyze(
     sources: Any = None,
     progress: Callable[[str], None] | None = None,
     command: str | None = None,
-    on_modes: Callable[[ModesReady], object] | None = None,
 ) -> Analysis:
     """The main job: modes, response to disturbances, compliance, isolation advice.
 
@@ -148,9 +119,6 @@ def analyze(
         Called with a stage name as each stage starts.
     command : str, optional
         The command line, for the provenance record.
-    on_modes : callable, optional
-        Called with a :class:`ModesReady` as soon as the modes are solved, before the
-        response (``microg analyze`` starts drawing the model's figures then).
 
     Returns
     -------
@@ -230,7 +198,6 @@ def analyze(
         progress=progress,
         requirement=requirement if isinstance(requirement, Requirement) else None,
         command=command,
-        on_modes=on_modes,
     )
 
 
@@ -296,7 +263,6 @@ def run_analysis(
     progress: Callable[[str], None] | None = None,
     requirement: Requirement | None = None,
     command: str | None = None,
-    on_modes: Callable[[ModesReady], object] | None = None,
 ) -> Analysis:
     """Run the main job on a model with validated options (see :func:`analyze`).
 
@@ -310,8 +276,6 @@ def run_analysis(
         Overrides ``opts.requirement`` (a custom requirement object).
     command : str, optional
         The command line, for the provenance record.
-    on_modes : callable, optional
-        Called with a :class:`ModesReady` once the modes are solved, before the response.
     """
     step = progress or (lambda _s: None)
     _check_options(opts)
@@ -330,10 +294,7 @@ def run_analysis(
         # the vibratory regime reaches 300 Hz: sources need the modes well above it
         default = DEFAULT_SOURCE_MODES if opts.sources is not None else DEFAULT_N_MODES
         n_req = min(structure.n_dof - 1, opts.n_modes or default)
-    # a small structure (a modal model: its modes; the IOC FEM) on one BLAS thread; a large
-    # one keeps the threads for its sparse eigensolve (solve_modes limits its own small steps)
-    with blas_threads(structure.n_dof):
-        modes = solve_modes(structure, n_req)
+    modes = solve_modes(structure, n_req)
     # the model file's hash runs beside the response and assessment (compute-bound), not the
     # structure and modes, whose scans of the mode shapes compete with it for memory bandwidth
     provenance = Provenance(model, command)
@@ -341,17 +302,11 @@ def run_analysis(
     elastic = modes.elastic
     used = modes.rigid | (np.asarray(elastic) & (modes.freq_hz <= opts.max_freq_hz))
     name = str(getattr(model, "name", None) or structure.meta.get("model", "model"))
-    if on_modes is not None:
-        on_modes(ModesReady(name, opts, structure, modes, used))
     observations: dict[str, Observation] = {}
     t = np.zeros(0)
     if opts.disturbances:
         warnings += check_modes_used(modes, np.asarray(elastic, bool), used, opts.max_freq_hz)
-        # the transient's products contract over the modes (a few hundred): small GEMMs, on
-        # one BLAS thread (two contend with each other and with the provenance hash: the
-        # modal-model benchmark's point projections take 0.045 s on one, 0.08-0.15 s on two)
-        with blas_threads(modes.n_modes):
-            observations, t, w = transient(structure, modes, used, opts, req, step)
+        observations, t, w = transient(structure, modes, used, opts, req, step)
         warnings += w
     vib = None
     if opts.sources is not None:

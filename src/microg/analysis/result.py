@@ -98,11 +98,19 @@ class Observation:
             attrs={"units": "m/s^2", "point": self.name, "long_name": "acceleration"},
         )
 
-    def plot(self) -> Figure:
-        """Acceleration history and 1/3-octave bands against the requirement (a Figure)."""
+    def plot(self, ax: Any = None, *, kind: str | None = None) -> Figure:
+        """Acceleration history and 1/3-octave bands against the requirement (a Figure).
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes or a pair of them, optional
+            Where to draw (one axes: the history, or ``kind``; two: both panels).
+        kind : {"history", "bands"}, optional
+            One panel only (see :func:`microg.plotting.analysis.observation_figure`).
+        """
         from microg.plotting.analysis import observation_figure
 
-        return observation_figure(self)
+        return observation_figure(self, ax=ax, kind=kind)
 
 
 @dataclass(frozen=True)
@@ -254,11 +262,17 @@ class Analysis:
             },
         )
 
-    def plot(self) -> Figure:
-        """The modes used and the peak at each observed point (a Figure)."""
+    def plot(self, ax: Any = None) -> Figure:
+        """The peak at each observed point against the report's 1e-5 g (a Figure).
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Where to draw (default: a new figure).
+        """
         from microg.plotting.analysis import analysis_figure
 
-        return analysis_figure(self)
+        return analysis_figure(self, ax=ax)
 
 
 def _disturbance_dict(d: Disturbance) -> dict[str, Any]:

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import importlib
 import importlib.util
+import os
 import sys
 
 import click
@@ -72,23 +73,31 @@ def _one_line(text: str) -> str:
 def main(argv: list[str] | None = None) -> int:
     """Entry point: run the CLI, turning input errors into one line and exit status 2.
 
-    Run as the process (``argv`` None: the ``microg`` script, ``python -m microg``), the
-    objects alive at the end are frozen out of the garbage collector (``gc.freeze``) before
-    the interpreter exits: its final collections over matplotlib's and scipy's object graphs
-    took ~0.25 s of a 2-s ``microg analyze``, for memory the exit frees anyway.
-    The exit itself (atexit handlers, stream flushes, module teardown) is unchanged.
+    Run as the process (``argv`` None: the ``microg`` script, ``python -m microg``), BLAS
+    starts on one thread unless the user set a thread count (:func:`one_blas_thread`).
     """
     if argv is None:
-        from microg.cli._startup import install
+        one_blas_thread()
+    return _run(argv)
 
-        install()
-    try:
-        return _run(argv)
-    finally:
-        if argv is None:
-            import gc
 
-            gc.freeze()
+#: environment variables by which a user sets the BLAS thread count
+BLAS_ENV = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "BLIS_NUM_THREADS")
+
+
+def one_blas_thread() -> bool:
+    """Start BLAS on one thread in this process, unless the user chose a count; whether it did.
+
+    The ``microg`` commands' dense problems are small (the IOC model: 240 coordinates), and
+    OpenBLAS's second thread then only contends with the first.  Only before numpy is
+    imported (OpenBLAS reads the variables when it loads), and never when any of
+    :data:`BLAS_ENV` is set: the user's own setting wins.  Child processes inherit them.
+    """
+    if "numpy" in sys.modules or any(os.environ.get(v) for v in BLAS_ENV):
+        return False
+    for name in BLAS_ENV[1:]:  # whichever BLAS numpy and scipy were built with
+        os.environ[name] = "1"
+    return True
 
 
 def _run(argv: list[str] | None) -> int:

@@ -7,7 +7,6 @@ name its parameters, which :func:`flag_errors` maps back to the options.
 
 from __future__ import annotations
 
-import contextlib
 import shlex
 import sys
 from pathlib import Path
@@ -273,10 +272,7 @@ def analyze(
         for k, v in (("units", units), ("wtmass", wtmass), ("points", points_file))
         if v is not None
     }
-    with flag_errors(FLAGS), contextlib.ExitStack() as stack:
-        # the figure helper forks first: a visible progress bar runs a monitor thread, and a
-        # process with threads does not fork (microg.report.render)
-        renderer = stack.enter_context(_renderer())
+    with flag_errors(FLAGS):
         bar = progress_bar(len(stages), "microg analyze", hide=no_progress)
 
         def progress(stage: str) -> None:
@@ -284,7 +280,6 @@ def analyze(
             if stage != "structure":
                 bar.update(1)
 
-        # in-process: the figure helper forked above already has the second core
         mdl = microg.load_model(model, **reader)
         result = microg.analyze(
             mdl,
@@ -299,43 +294,16 @@ def analyze(
             gravity_gradient=gravity_gradient,
             progress=progress,
             command=command,
-            on_modes=_early_figures(renderer),
             **kwargs,
         )
         progress("report")
-        path, text = write_outputs(result, out_dir, renderer)
+        path, text = write_outputs(result, out_dir)
     bar.update(1)
     bar.close()
     if as_json:
         click.echo(text)
     else:
         summary(result, path)
-
-
-def _renderer() -> Any:
-    """Helper processes for the figures (:func:`microg.report.analysis.start_renderer`).
-
-    Only the ``microg`` process starts them, before it loads the model: they import
-    matplotlib (and the modules the result unpickles with) on the second core while this
-    process loads and computes, then draw the figures.  A library caller of
-    :func:`main` draws in-process, as ``microg.analyze`` users do.
-    """
-    from microg.cli._startup import is_process
-
-    if not is_process():
-        return contextlib.nullcontext(None)
-    from microg.report.analysis import start_renderer
-
-    return start_renderer()
-
-
-def _early_figures(renderer: Any) -> Any:
-    """The helpers start on the model's figures once the modes are solved (none: None)."""
-    if renderer is None:
-        return None
-    from microg.report.analysis import early_figures
-
-    return early_figures(renderer)
 
 
 def _check_out(out_dir: Path) -> None:
@@ -350,23 +318,17 @@ def _check_out(out_dir: Path) -> None:
     check_writable(out_dir, where="--out")
 
 
-def write_outputs(result: Any, out_dir: Path, renderer: Any = None) -> tuple[Path, str]:
+def write_outputs(result: Any, out_dir: Path) -> tuple[Path, str]:
     """Render figures, HTML and JSON, and write them into ``out_dir`` as one run.
 
-    Returns the directory and the JSON text (``result.to_dict()``, what ``--json`` prints),
-    which is written while the ``renderer``'s helpers, if any, draw the figures.
+    Returns the directory and the JSON text (``result.to_dict()``, what ``--json`` prints).
     """
     from microg._io import dumps, write_output_files
     from microg.report.analysis import report_files
 
-    box: dict[str, str] = {}
-
-    def json_text(summary: dict[str, Any]) -> None:
-        box["json"] = dumps(summary)  # result.to_dict()
-
-    report = report_files(result, renderer, while_waiting=json_text)
-    text = box["json"]
-    files: dict[str, bytes | str] = {**report, "results.json": text}
+    summary = result.to_dict()
+    text = dumps(summary)
+    files: dict[str, bytes | str] = {**report_files(result, summary), "results.json": text}
     return write_output_files(out_dir, files, where="--out"), text
 
 

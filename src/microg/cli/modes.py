@@ -148,7 +148,6 @@ def modes(
     import microg
     from microg._io import check_writable, dumps
     from microg.cli._errors import flag_errors
-    from microg.cli._load import load_model
     from microg.errors import InputError
     from microg.structure.discretize import discretize
 
@@ -161,7 +160,7 @@ def modes(
     given = (("units", units), ("wtmass", wtmass), ("points", points))
     options = {k: v for k, v in given if v is not None}
     with flag_errors(FLAGS):
-        mdl = load_model(model, method, **options)
+        mdl = microg.load_model(model, **options)
         fem_plane = method == "fem" and plane != "3d"
         structure = discretize(
             mdl,

@@ -23,7 +23,6 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
-from threadpoolctl import threadpool_limits
 
 from microg.dynamics.bandquad import converged_quadrature
 from microg.dynamics.frf import factor_parts
@@ -277,7 +276,7 @@ def band_mean_squares(
     groups : (s,) coherent group index per source (default: all independent)
     order : Gauss-Legendre points per sub-interval
     rtol : convergence tolerance of the band integration (relative)
-    workers : threads over bands (default the number of CPUs); each uses one BLAS thread
+    workers : threads over bands (default the number of CPUs); BLAS keeps the process's threads
     contributions : compute the per-mode contributions (``mode_alone``, ``mode_share``; zero
         when False, about half the work)
 
@@ -353,13 +352,13 @@ def band_mean_squares(
             )
             return b, live, part
 
-        # bands in parallel threads, one BLAS thread each (the products are mid-sized:
-        # BLAS threads on top of band threads only contend)
+        # bands in parallel threads; BLAS keeps the process's thread setting (a library
+        # call never changes it: ``microg`` starts BLAS on one thread)
         nworkers = max(1, min(int(workers or os.cpu_count() or 1), nb))
         if nworkers == 1:
             results = [one_band(b) for b in range(nb)]
         else:
-            with threadpool_limits(limits=1), ThreadPoolExecutor(max_workers=nworkers) as pool:
+            with ThreadPoolExecutor(max_workers=nworkers) as pool:
                 results = list(pool.map(one_band, range(nb)))
         for res in results:
             if res is None:

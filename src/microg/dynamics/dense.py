@@ -35,10 +35,7 @@ Method (:func:`solve_dense`), each step a documented choice:
 
 from __future__ import annotations
 
-import os
-import sys
 from collections.abc import Iterator
-from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -49,11 +46,9 @@ from microg.errors import InputError, SolverError
 
 __all__ = [
     "ACCEPT_REL",
-    "BLAS_THREADS_MIN_N",
     "Eigensolution",
     "MASSLESS_TOL",
     "RESIDUAL_TOL",
-    "blas_threads",
     "graded_eigh",
     "m_orthonormal_ascending",
     "moving_components",
@@ -73,73 +68,6 @@ RESIDUAL_TOL = 1e-8
 SUPPORT_CANCEL = 1e-6
 #: most levels of the graded solve (each resolves at least four decades of the spectrum)
 MAX_LEVELS = 24
-#: dense problems smaller than this run on one BLAS thread.  Measured on this project's
-#: 2-core machine (OpenBLAS 0.3.30, pthreads): a 240 x 240 Cholesky takes 1.6 ms on one
-#: thread and 375 ms on two; a 150-coordinate Ritz solve 0.05 s against 2.8 s
-BLAS_THREADS_MIN_N = 4000
-
-_CONTROLLER: Any = None
-#: whether scipy.linalg (and with it scipy's own OpenBLAS) was loaded when _CONTROLLER
-#: scanned the libraries: a controller made before it would leave scipy's BLAS unlimited
-_CONTROLLER_SAW_SCIPY = False
-
-
-def _large() -> int | None:
-    """Threads for a large problem: ``MICROG_BLAS_CORES`` if set, else as they are (None)."""
-    try:
-        return max(1, int(os.environ["MICROG_BLAS_CORES"]))
-    except (KeyError, ValueError):
-        return None
-
-
-#: the variables by which :mod:`microg.cli._startup` starts BLAS on one thread (its
-#: ``ONE_THREAD_ENV``: that module runs before numpy loads, so it cannot import this one)
-_ONE_THREAD_ENV = ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "BLIS_NUM_THREADS")
-
-
-def _started_on_one_thread() -> bool:
-    """Whether this process started its BLAS on one thread (:mod:`microg.cli._startup`)."""
-    return _large() is not None and all(os.environ.get(v) == "1" for v in _ONE_THREAD_ENV)
-
-
-@contextmanager
-def blas_threads(n: int, threads: int | None = None) -> Iterator[None]:
-    """Limit BLAS to one thread (or ``threads``) for a problem of dimension ``n``.
-
-    Below :data:`BLAS_THREADS_MIN_N` the thread start-up and contention of OpenBLAS cost
-    far more than the work (see the constant); above it the threads are left as they are,
-    except in a ``microg`` process that started BLAS on one thread (``MICROG_BLAS_CORES``,
-    set by :mod:`microg.cli._startup`), where a large problem gets the usable cores back.
-
-    Parameters
-    ----------
-    n : int
-        The dense dimension of the work (matrix order, or the sparse solver's basis size).
-    threads : int, optional
-        An explicit count (None: by the rule above).
-    """
-    global _CONTROLLER, _CONTROLLER_SAW_SCIPY
-    want = threads if threads is not None else (1 if n < BLAS_THREADS_MIN_N else _large())
-    if want is None or (want == 1 and _CONTROLLER is None and _started_on_one_thread()):
-        # nothing to change: as they are, or still the one thread the process started with
-        # (threadpoolctl's import and library scan, ~10 ms, are spared)
-        yield
-        return
-    try:
-        scipy_loaded = "scipy.linalg" in sys.modules  # scipy loads on first use
-        if _CONTROLLER is None or (scipy_loaded and not _CONTROLLER_SAW_SCIPY):
-            from threadpoolctl import ThreadpoolController
-
-            _CONTROLLER = ThreadpoolController()  # scans the BLAS libraries loaded now
-            _CONTROLLER_SAW_SCIPY = scipy_loaded
-        ctx = _CONTROLLER.limit(limits=int(want), user_api="blas")
-    except Exception:  # threadpoolctl missing or no BLAS found: nothing to limit
-        yield
-        return
-    with ctx:
-        yield
-
-
 @dataclass(frozen=True)
 class Eigensolution:
     """Modes of a free-free pencil ``K phi = lambda M phi``, rigid ones first.
@@ -524,8 +452,7 @@ def solve_dense(
     """
     mass = _check_symmetric(np.asarray(mass, dtype=float), "mass")
     stiffness = _check_symmetric(np.asarray(stiffness, dtype=float), "stiffness")
-    with blas_threads(mass.shape[0]):
-        return _solve_dense(mass, stiffness, rigid_candidates, tol, labels, rigid_vectors)
+    return _solve_dense(mass, stiffness, rigid_candidates, tol, labels, rigid_vectors)
 
 
 def _solve_dense(

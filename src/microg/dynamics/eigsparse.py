@@ -48,7 +48,6 @@ from microg.dynamics.dense import (
     Eigensolution,
     _finish,
     _scaling,
-    blas_threads,
     graded_eigh,
     m_orthonormal_ascending,
     moving_components,
@@ -144,9 +143,8 @@ def solve_sparse(
             # perturbation of the free-free modes, 4e-7 through G)
             flexibility = None
         if flexibility is not None:
-            with blas_threads(n):  # the clean-up's Cholesky too: small, so one thread
-                lam, X = _dense_with_flexibility(M.toarray(), K.toarray(), B, flexibility)
-                sol = _finish(M, K, B, lam, X, labels, [], check_zero=False)
+            lam, X = _dense_with_flexibility(M.toarray(), K.toarray(), B, flexibility)
+            sol = _finish(M, K, B, lam, X, labels, [], check_zero=False)
         else:
             sol = solve_dense(M.toarray(), K.toarray(), labels=labels, rigid_vectors=B)
         return sol.truncate(max(n_modes, r))
@@ -155,9 +153,8 @@ def solve_sparse(
     if generic:
         flexibility = _isostatic_inverse(K, B, labels)
     assert flexibility is not None
-    with blas_threads(lanczos_basis_size(k_el, n)):
-        lam, X = _elastic_inverse_iteration(M, B, flexibility, k_el)
-        return _finish(M, K, B, lam, X, labels, [], check_zero=generic, orthonormalize=False)
+    lam, X = _elastic_inverse_iteration(M, B, flexibility, k_el)
+    return _finish(M, K, B, lam, X, labels, [], check_zero=generic, orthonormalize=False)
 
 
 def _restrained(g: Operator) -> bool:

@@ -11,8 +11,7 @@ rate instead of a frequency.
 Dense models (assumed modes) use :func:`~microg.dynamics.dense.solve_dense`, sparse ones
 (frame elements) :func:`~microg.dynamics.eigsparse.solve_sparse`, with the exact tree
 flexibility of :class:`~microg.structure.fem.FrameStructure` where the model has one.  BLAS
-runs on one thread for problems where its threads cost more than they save
-(:func:`~microg.dynamics.dense.blas_threads`).
+runs with the threads the process has (the library never changes them).
 """
 
 from __future__ import annotations
@@ -23,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from microg.dynamics.dense import Eigensolution, blas_threads, solve_dense
+from microg.dynamics.dense import Eigensolution, solve_dense
 from microg.dynamics.rigid import RIGID_TOL
 from microg.structure.structure import Structure
 
@@ -399,9 +398,8 @@ def solve_modes(
         sol = solve_dense(m, k, cand, tol=tol, labels=labels)
         if n_modes is not None:
             sol = sol.truncate(n_modes)
-    with blas_threads(min(structure.n_dof, sol.phi.shape[1] * 8)):
-        eff, part = effective_mass(structure.mass, sol.phi, rb)
-        modal_mass = _modal_mass_unit_peak(structure, sol.phi)
+    eff, part = effective_mass(structure.mass, sol.phi, rb)
+    modal_mass = _modal_mass_unit_peak(structure, sol.phi)
     notes = [
         nt
         for nt in sol.notes

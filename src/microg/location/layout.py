@@ -22,7 +22,6 @@ through ``discretize``, and the two agree to rounding (tested to 1e-9).
 
 from __future__ import annotations
 
-import contextlib
 import dataclasses
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
@@ -706,7 +705,6 @@ def optimize_layout(
         Called after each generation.
     """
     from scipy.optimize import differential_evolution, minimize
-    from threadpoolctl import threadpool_limits
 
     from microg.dynamics.modes import solve_modes
     from microg.location.amap import check_point, default_point
@@ -780,28 +778,25 @@ def optimize_layout(
             progress(generation[0], maxiter)
 
     bounds = list(zip(lo, hi, strict=True))
-    # each trial is a small dense eigenproblem: one BLAS thread is fastest (threads contend)
-    limit = threadpool_limits(limits=1) if fast is not None else contextlib.nullcontext()
-    with limit:
-        j0 = fun(x0)
-        de = differential_evolution(
-            fun,
-            bounds,
-            seed=seed,
-            maxiter=maxiter,
-            popsize=popsize,
-            tol=1e-8,
-            polish=False,
-            init="sobol",
-            callback=callback,
-        )
-        best_x, best_f = np.asarray(de.x, float), float(de.fun)
-        message, success = str(de.message), bool(de.success)
-        if polish:
-            loc = minimize(fun, best_x, method="L-BFGS-B", bounds=bounds)
-            if loc.fun < best_f:
-                best_x, best_f = np.asarray(loc.x, float), float(loc.fun)
-                message += f"; L-BFGS-B: {loc.message}"
+    j0 = fun(x0)
+    de = differential_evolution(
+        fun,
+        bounds,
+        seed=seed,
+        maxiter=maxiter,
+        popsize=popsize,
+        tol=1e-8,
+        polish=False,
+        init="sobol",
+        callback=callback,
+    )
+    best_x, best_f = np.asarray(de.x, float), float(de.fun)
+    message, success = str(de.message), bool(de.success)
+    if polish:
+        loc = minimize(fun, best_x, method="L-BFGS-B", bounds=bounds)
+        if loc.fun < best_f:
+            best_x, best_f = np.asarray(loc.x, float), float(loc.fun)
+            message += f"; L-BFGS-B: {loc.message}"
     if j0 <= best_f:  # never report a layout worse than the start
         best_x, best_f = x0.copy(), j0
     best_x = np.clip(best_x, lo, hi)

@@ -9,13 +9,15 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
-from microg.plotting.common import envelope, finish, new_figure
+from microg.errors import InputError
+from microg.plotting.common import envelope, figure_axes, figure_grid, figure_of
 from microg.units import G0
 
 if TYPE_CHECKING:
-    from microg.analysis import Analysis, ModesReady, Observation
+    from microg.analysis import Analysis, Observation
     from microg.dynamics.modes import Modes
     from microg.structure.structure import Structure
 
@@ -99,6 +101,8 @@ def model_figure(
     force_points: dict[str, np.ndarray],
     observed: list[str],
     n_shapes: int = 3,
+    *,
+    ax: Any = None,
 ) -> Figure:
     """The model with its force and observed points (two views), and the first mode shapes.
 
@@ -114,29 +118,44 @@ def model_figure(
         Observed point names, drawn as squares.
     n_shapes : int
         Elastic mode shapes to draw.
+    ax : sequence of matplotlib.axes.Axes, optional
+        Where to draw: the two views, then one axes per mode shape (shapes beyond the axes
+        given are not drawn).  Default: a new figure, the views above the shapes.
     """
     elastic = np.flatnonzero(~modes.rigid & (modes.omega > 0))[:n_shapes]
     pos, u = sample_displacements(structure, modes.phi[:, elastic])
     groups = _groups(structure, pos.shape[0])
     views = _views(pos)
     size = float(np.max(np.ptp(pos, axis=0))) if pos.size else 1.0
-    ncol = max(len(elastic), 2)
-    fig = new_figure(7.8, 7.6)
-    grid = fig.add_gridspec(2, ncol * 2)
+    if ax is None:
+        ncol = max(len(elastic), 2)
+        fig = Figure(figsize=(7.8, 7.6), layout="constrained")
+        grid = fig.add_gridspec(2, ncol * 2)
+        panels = [fig.add_subplot(grid[0, c * ncol : (c + 1) * ncol]) for c in range(2)]
+        panels += [fig.add_subplot(grid[1, 2 * k : 2 * k + 2]) for k in range(len(elastic))]
+    else:
+        panels = list(np.asarray(ax, dtype=object).ravel())
+        if len(panels) < 2 or not all(isinstance(a, Axes) for a in panels):
+            raise InputError(
+                f"expected at least 2 matplotlib Axes (two views, then mode shapes), got "
+                f"{len(panels)}",
+                where="ax",
+            )
+        fig = figure_of(panels[0])
+        elastic = elastic[: len(panels) - 2]
     names = "xyz"
-    for col, (h, v) in enumerate(views):
-        ax = fig.add_subplot(grid[0, col * ncol : (col + 1) * ncol])
-        _draw(ax, pos, groups, h, v, color="0.35", lw=1.6, marker=".", ms=3)
+    for a, (h, v) in zip(panels[:2], views, strict=True):
+        _draw(a, pos, groups, h, v, color="0.35", lw=1.6, marker=".", ms=3)
         for name, d in force_points.items():
             p = structure.points[name].position
-            ax.annotate(
+            a.annotate(
                 "",
                 xy=(p[h] + 0.1 * size * d[h], p[v] + 0.1 * size * d[v]),
                 xytext=(p[h], p[v]),
                 arrowprops={"arrowstyle": "->", "color": "crimson", "lw": 1.8},
             )
-            ax.plot(p[h], p[v], "o", color="crimson", ms=6)
-            ax.annotate(
+            a.plot(p[h], p[v], "o", color="crimson", ms=6)
+            a.annotate(
                 f"force at {name}",
                 (p[h], p[v]),
                 fontsize=8,
@@ -146,8 +165,8 @@ def model_figure(
             )
         for name in observed:
             p = structure.points[name].position
-            ax.plot(p[h], p[v], "s", color="navy", ms=7, mfc="none", mew=1.5)
-            ax.annotate(
+            a.plot(p[h], p[v], "s", color="navy", ms=7, mfc="none", mew=1.5)
+            a.annotate(
                 name,
                 (p[h], p[v]),
                 fontsize=8,
@@ -155,11 +174,11 @@ def model_figure(
                 xytext=(5, -11),
                 textcoords="offset points",
             )
-        ax.set_aspect("equal", adjustable="datalim")
-        ax.set_xlabel(f"{names[h]} [m]")
-        ax.set_ylabel(f"{names[v]} [m]")
-        ax.set_title(f"{names[h]}-{names[v]} view (force red, observed blue)", fontsize=9)
-        ax.grid(True, alpha=0.3)
+        a.set_aspect("equal", adjustable="datalim")
+        a.set_xlabel(f"{names[h]} [m]")
+        a.set_ylabel(f"{names[v]} [m]")
+        a.set_title(f"{names[h]}-{names[v]} view (force red, observed blue)", fontsize=9)
+        a.grid(True, alpha=0.3)
     for k, j in enumerate(elastic):
         disp = u[:, :, k]
         # the view in which this mode moves most
@@ -167,22 +186,29 @@ def model_figure(
         h, v = max(candidates, key=lambda hv: _in_view(pos, disp, hv))
         peak = float(np.max(np.abs(disp))) or 1.0
         shape = pos + 0.1 * size * disp / peak
-        ax = fig.add_subplot(
-            grid[1, 2 * k : 2 * k + 2] if ncol == len(elastic) else grid[1, k * 2 : k * 2 + 2]
-        )
-        _draw(ax, pos, groups, h, v, color="0.75", lw=1.0)
-        _draw(ax, shape, groups, h, v, color=f"C{k}", lw=1.6)
-        ax.set_aspect("equal", adjustable="datalim")
-        ax.set_title(f"mode {j + 1}: {modes.freq_hz[j]:.3g} Hz ({names[h]}-{names[v]})", fontsize=9)
-        ax.set_xticks([])
-        ax.set_yticks([])
-    return finish(fig, left=0.75, right=0.15, bottom=0.1, top=0.3, hspace=0.85, wspace=0.85)
+        a = panels[2 + k]
+        _draw(a, pos, groups, h, v, color="0.75", lw=1.0)
+        _draw(a, shape, groups, h, v, color=f"C{k}", lw=1.6)
+        a.set_aspect("equal", adjustable="datalim")
+        a.set_title(f"mode {j + 1}: {modes.freq_hz[j]:.3g} Hz ({names[h]}-{names[v]})", fontsize=9)
+        a.set_xticks([])
+        a.set_yticks([])
+    return fig
 
 
-def force_figure(disturbances: list[Any], duration_s: float) -> Figure:
-    """Each force history f(t) over the record (N), from its breakpoints."""
-    fig = new_figure(7.5, 3.2)
-    ax = fig.subplots()
+def force_figure(disturbances: list[Any], duration_s: float, *, ax: Axes | None = None) -> Figure:
+    """Each force history f(t) over the record (N), from its breakpoints.
+
+    Parameters
+    ----------
+    disturbances : list of Disturbance
+        Their force histories (breakpoints in s and N) and points.
+    duration_s : float
+        The record's length, s (the last force value is held to it).
+    ax : matplotlib.axes.Axes, optional
+        Where to draw (default: a new figure).
+    """
+    fig, ax = figure_axes(ax, 7.5, 3.2)
     for d in disturbances:
         f = d.force
         t = np.r_[0.0, f.timepts, max(duration_s, float(f.timepts[-1]))]
@@ -193,19 +219,20 @@ def force_figure(disturbances: list[Any], duration_s: float) -> Figure:
     ax.set_title("Disturbances")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)
-    return finish(fig)
+    return fig
 
 
-def modes_figure(result: Analysis | ModesReady) -> Figure:
+def modes_figure(result: Analysis, *, ax: Axes | None = None) -> Figure:
     """Frequencies of the computed modes, numbered as in the modes table, used ones filled.
 
     Parameters
     ----------
-    result : Analysis or ModesReady
-        Its ``modes``, ``used``, ``options.max_freq_hz`` and ``model`` are drawn.
+    result : Analysis
+        Its ``modes``, ``used``, ``options.max_freq_hz`` (Hz) and ``model`` are drawn.
+    ax : matplotlib.axes.Axes, optional
+        Where to draw (default: a new figure).
     """
-    fig = new_figure(7.5, 3.6)
-    ax = fig.subplots()
+    fig, ax = figure_axes(ax, 7.5, 3.6)
     m = result.modes
     num = np.arange(1, m.n_modes + 1)
     el = m.omega > 0
@@ -218,7 +245,7 @@ def modes_figure(result: Analysis | ModesReady) -> Figure:
     ax.set_title(f"Modes of {result.model} ({m.n_rigid} rigid-body modes at 0 Hz, not drawn)")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
-    return finish(fig)
+    return fig
 
 
 def live_axes(accel: np.ndarray) -> list[int]:
@@ -232,41 +259,72 @@ def live_axes(accel: np.ndarray) -> list[int]:
     return [i for i in range(accel.shape[0]) if top > 0 and peak[i] > 1e-9 * top] or [0]
 
 
-def observation_figure(ob: Observation) -> Figure:
-    """Acceleration history (micro-g) and 1/3-octave band RMS against the limit at a point."""
+def observation_figure(ob: Observation, *, ax: Any = None, kind: str | None = None) -> Figure:
+    """Acceleration history (micro-g) and 1/3-octave band RMS against the limit at a point.
+
+    Parameters
+    ----------
+    ob : Observation
+        The point's response (m/s^2, drawn in micro-g) and assessment (band RMS in g).
+    ax : matplotlib.axes.Axes or a pair of them, optional
+        Where to draw: one axes for one panel, or two for the history and the bands.
+        Default: a new figure with both panels.
+    kind : {"history", "bands"}, optional
+        One panel only.  Default: both, or the history when ``ax`` is one axes.
+    """
+    if kind not in (None, "history", "bands"):
+        raise InputError(f"unknown kind {kind!r}", where="kind", fix="use history or bands")
+    if kind is None and (ax is None or not isinstance(ax, Axes)):
+        fig, grid = figure_grid(ax, 2, 1, width_in=7.5, height_in=6.4)
+        _history_on(grid[0, 0], ob)
+        _bands_on(grid[1, 0], ob)
+        return fig
+    fig, one = figure_axes(ax, 7.5, 3.6)
+    (_bands_on if kind == "bands" else _history_on)(one, ob)
+    return fig
+
+
+def _history_on(ax: Any, ob: Observation) -> None:
+    """The acceleration history at a point, micro-g, its live axes."""
     r = ob.response
-    a = ob.assessment
-    live = live_axes(r.acceleration)
-    fig = new_figure(7.5, 6.4)
-    ax1, ax2 = fig.subplots(2, 1)
-    for i in live:
-        ax1.plot(*envelope(r.timepts, r.acceleration[i] * _UG), lw=0.8, label="xyz"[i])
-    ax1.set_xlabel("time [s]")
-    ax1.set_ylabel("acceleration [micro-g]")
-    ax1.set_title(f"Acceleration at {ob.name} (peak {a.peak_accel_g:.3g} g)")
-    ax1.grid(True, alpha=0.3)
-    ax1.legend(fontsize=8)
-    to = a.third_octave
-    for i in live:
-        ax2.loglog(
+    for i in live_axes(r.acceleration):
+        ax.plot(*envelope(r.timepts, r.acceleration[i] * _UG), lw=0.8, label="xyz"[i])
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("acceleration [micro-g]")
+    ax.set_title(f"Acceleration at {ob.name} (peak {ob.assessment.peak_accel_g:.3g} g)")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8)
+
+
+def _bands_on(ax: Any, ob: Observation) -> None:
+    """The 1/3-octave band RMS at a point against the limit's steps, micro-g."""
+    to = ob.assessment.third_octave
+    for i in live_axes(ob.response.acceleration):
+        ax.loglog(
             to.center_hz, np.maximum(to.rms_g[i] * 1e6, 1e-30), "o-", ms=3, lw=0.8, label="xyz"[i]
         )
     edges = np.r_[to.lower_hz, to.upper_hz[-1:]]
-    ax2.stairs(to.limit_g * 1e6, edges, color="k", lw=1.4, label="limit")
-    ax2.set_xlabel("frequency [Hz]")
-    ax2.set_ylabel("band RMS [micro-g]")
-    ax2.grid(True, which="both", alpha=0.3)
-    ax2.legend(fontsize=8)
-    return finish(fig, hspace=0.65)
+    ax.stairs(to.limit_g * 1e6, edges, color="k", lw=1.4, label="limit")
+    ax.set_xlabel("frequency [Hz]")
+    ax.set_ylabel("band RMS [micro-g]")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
 
 
-def isolation_figure(ob: Observation) -> Figure:
-    """Mount acceleration against what the isolated package feels, on the dominant axis."""
+def isolation_figure(ob: Observation, *, ax: Axes | None = None) -> Figure:
+    """Mount acceleration against what the isolated package feels, on the dominant axis.
+
+    Parameters
+    ----------
+    ob : Observation
+        The point's response and isolation advice (accelerations in m/s^2, drawn in micro-g).
+    ax : matplotlib.axes.Axes, optional
+        Where to draw (default: a new figure).
+    """
     adv = ob.isolation
     pkg = adv.package_accel
     r = ob.response
-    fig = new_figure(7.5, 3.8)
-    ax = fig.subplots()
+    fig, ax = figure_axes(ax, 7.5, 3.8)
     axis = int(np.argmax(np.max(np.abs(r.acceleration), axis=1)))
     ax.plot(*envelope(r.timepts, r.acceleration[axis] * _UG), lw=0.8, label="mount (station)")
     if pkg is not None:
@@ -277,15 +335,22 @@ def isolation_figure(ob: Observation) -> Figure:
     ax.set_title(f"Isolation check at {ob.name}: {adv.status}")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)
-    return finish(fig)
+    return fig
 
 
-def analysis_figure(result: Analysis) -> Figure:
-    """Peak acceleration at each observed point against the report's 1e-5 g."""
+def analysis_figure(result: Analysis, *, ax: Axes | None = None) -> Figure:
+    """Peak acceleration at each observed point against the report's 1e-5 g.
+
+    Parameters
+    ----------
+    result : Analysis
+        Its observations' peaks (g) and verdicts.
+    ax : matplotlib.axes.Axes, optional
+        Where to draw (default: a new figure).
+    """
     from microg.analysis import REPORT_LIMIT_G
 
-    fig = new_figure(7.5, 3.4)
-    ax = fig.subplots()
+    fig, ax = figure_axes(ax, 7.5, 3.4)
     names = list(result.observations)
     peaks = [result.observations[n].peak_accel_g for n in names]
     colors = ["tab:green" if result.observations[n].complies else "tab:red" for n in names]
@@ -295,4 +360,4 @@ def analysis_figure(result: Analysis) -> Figure:
     ax.set_ylabel("peak acceleration [g]")
     ax.set_title("Peak at each observed point (green: band verdict complies)")
     ax.legend(fontsize=8)
-    return finish(fig)
+    return fig

@@ -10,6 +10,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from microg.environment.metrics import (
@@ -19,7 +20,7 @@ from microg.environment.metrics import (
     _as_axes,
     integrated_acceleration,
 )
-from microg.plotting.common import envelope, finish, new_figure
+from microg.plotting.common import envelope, figure_axes, figure_grid
 from microg.units import G0
 
 if TYPE_CHECKING:
@@ -39,9 +40,9 @@ __all__ = [
 ]
 
 
-def _figure(title: str) -> tuple[Figure, Any]:
-    fig = new_figure(7.5, 4.5)
-    ax = fig.add_subplot()
+def _figure(ax: Axes | None, title: str) -> tuple[Figure, Axes]:
+    """The figure and axes to draw into (the caller's ``ax`` or a new one), titled."""
+    fig, ax = figure_axes(ax, 7.5, 4.5)
     if title:
         ax.set_title(title)
     return fig, ax
@@ -62,9 +63,14 @@ def plot_time_history(
     *,
     axes: tuple[str, ...] = ("x", "y", "z"),
     title: str = "",
+    ax: Axes | None = None,
 ) -> Figure:
-    """Acceleration (m/s^2 in, plotted in micro-g) against time (s); returns a Figure."""
-    fig, ax = _figure(title or "Acceleration")
+    """Acceleration (m/s^2 in, plotted in micro-g) against time (s); returns the Figure.
+
+    ``ax``: the matplotlib axes to draw into (default: a new figure), as for every plot
+    function of this module.
+    """
+    fig, ax = _figure(ax, title or "Acceleration")
     a = _as_axes(accel) / G0 * 1e6
     for name, row in zip(axes, a, strict=False):
         ax.plot(*envelope(timepts, row), label=name, lw=0.8)
@@ -72,14 +78,18 @@ def plot_time_history(
     ax.set_ylabel("acceleration [micro-g]")
     ax.grid(True, alpha=0.3)
     ax.legend()
-    return finish(fig)
+    return fig
 
 
 def plot_psd(
-    spectrum: Spectrum, *, axes: tuple[str, ...] = ("x", "y", "z"), title: str = ""
+    spectrum: Spectrum,
+    *,
+    axes: tuple[str, ...] = ("x", "y", "z"),
+    title: str = "",
+    ax: Axes | None = None,
 ) -> Figure:
-    """PSD in g^2/Hz against frequency (log-log, the 0-Hz bin left out); returns a Figure."""
-    fig, ax = _figure(title or f"PSD ({spectrum.method})")
+    """PSD in g^2/Hz against frequency (log-log, the 0-Hz bin left out); returns the Figure."""
+    fig, ax = _figure(ax, title or f"PSD ({spectrum.method})")
     f = spectrum.freq_hz[1:]
     top = max(float(np.max(spectrum.psd[:, 1:], initial=0.0)) / G0**2, 1e-300)
     for name, row in zip(axes, spectrum.psd, strict=False):
@@ -89,7 +99,7 @@ def plot_psd(
     ax.set_ylabel("PSD [g^2/Hz]")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
-    return finish(fig)
+    return fig
 
 
 def _bands_on(ax: Any, to: ThirdOctave, axes: tuple[str, ...], style: str, label: str) -> None:
@@ -131,6 +141,7 @@ def plot_bands(
     axes: tuple[str, ...] = ("x", "y", "z"),
     title: str = "",
     verdict_range_hz: tuple[float, float] | None = None,
+    ax: Axes | None = None,
 ) -> Figure:
     """1/3-octave band RMS per axis against the limit's steps (micro-g); returns a Figure.
 
@@ -144,21 +155,23 @@ def plot_bands(
         Figure title (default: a generic one).
     verdict_range_hz : (float, float), optional
         The frequency range the verdict covers, Hz, shaded (default: the judged bands').
+    ax : matplotlib.axes.Axes, optional
+        Where to draw (default: a new figure).
 
     Filled markers: bands the verdict judges; hollow: bands the record does not resolve (left
     out of the verdict).
     """
-    fig, ax = _figure(title or "1/3-octave band RMS")
+    fig, ax = _figure(ax, title or "1/3-octave band RMS")
     _bands_on(ax, to, axes, "o-", "")
     _limit_on(ax, to.lower_hz, to.upper_hz, to.limit_g)
     vr = verdict_range_hz if verdict_range_hz is not None else to.verdict_range_hz
     if vr is not None:
         ax.axvspan(vr[0], vr[1], color="0.85", alpha=0.4, lw=0, label="judged bands")
     _band_axes(ax)
-    return finish(fig)
+    return fig
 
 
-def plot_third_octave(assessment: Assessment, *, title: str = "") -> Figure:
+def plot_third_octave(assessment: Assessment, *, title: str = "", ax: Axes | None = None) -> Figure:
     """1/3-octave band RMS per axis against the requirement's steps (micro-g); returns a Figure.
 
     Filled markers: bands the verdict judges; hollow: bands the record does not resolve (left
@@ -169,12 +182,13 @@ def plot_third_octave(assessment: Assessment, *, title: str = "") -> Figure:
         axes=assessment.axes,
         title=title or f"1/3-octave band RMS vs {assessment.requirement}",
         verdict_range_hz=assessment.verdict_range_hz,
+        ax=ax,
     )
 
 
-def plot_requirement(req: Requirement, *, title: str = "") -> Figure:
+def plot_requirement(req: Requirement, *, title: str = "", ax: Axes | None = None) -> Figure:
     """A requirement's band-RMS limit as steps on the band edges (micro-g); returns a Figure."""
-    fig, ax = _figure(title or f"Requirement {req.name}")
+    fig, ax = _figure(ax, title or f"Requirement {req.name}")
     b = req.bands
     _limit_on(ax, b.lower_hz, b.upper_hz, req.limit_g)
     ax.plot(b.center_hz, np.asarray(req.limit_g, float) * 1e6, "o", ms=3, color="k", label="_c")
@@ -182,7 +196,7 @@ def plot_requirement(req: Requirement, *, title: str = "") -> Figure:
         ax.axhline(req.peak_limit_g * 1e6, color="crimson", ls="--", lw=1.0, label="peak limit")
     _band_axes(ax)
     ax.set_ylabel("band-RMS limit [micro-g]")
-    return finish(fig)
+    return fig
 
 
 def plot_integrated(
@@ -190,17 +204,18 @@ def plot_integrated(
     *,
     axes: tuple[str, ...] = ("x", "y", "z"),
     title: str = "",
+    ax: Axes | None = None,
 ) -> Figure:
     """Each window's (or block's) integral of the acceleration (m/s) against its start, s."""
     kind = "blocks" if hasattr(integ, "block_samples") else "sliding"
-    fig, ax = _figure(title or f"Integrated acceleration, {kind} {integ.window_s:g}-s windows")
+    fig, ax = _figure(ax, title or f"Integrated acceleration, {kind} {integ.window_s:g}-s windows")
     for name, row in zip(axes, integ.delta_v, strict=False):
         ax.plot(*envelope(integ.t_start, row), label=name, lw=0.8)
     ax.set_xlabel("window start [s]")
     ax.set_ylabel("integral of acceleration [m/s]")
     ax.grid(True, alpha=0.3)
     ax.legend()
-    return finish(fig)
+    return fig
 
 
 def plot_integrated_acceleration(
@@ -210,10 +225,11 @@ def plot_integrated_acceleration(
     window_s: float = 10.0,
     axes: tuple[str, ...] = ("x", "y", "z"),
     title: str = "",
+    ax: Axes | None = None,
 ) -> Figure:
     """Integrated acceleration over sliding windows (m/s) of a record (times s, m/s^2)."""
     return plot_integrated(
-        integrated_acceleration(timepts, accel, window_s), axes=axes, title=title
+        integrated_acceleration(timepts, accel, window_s), axes=axes, title=title, ax=ax
     )
 
 
@@ -223,14 +239,16 @@ def plot_overlay(
     *,
     labels: tuple[str, str] = ("prediction", "measurement"),
     title: str = "",
+    ax: Any = None,
 ) -> Figure:
     """A prediction and a measurement at one site: band RMS per axis and PSD; returns a Figure.
 
     Top: 1/3-octave band RMS of both (solid: the first, dashed: the second) against the
-    first's requirement steps.  Bottom: their PSDs, worst axis by RMS, in g^2/Hz.
+    first's requirement steps.  Bottom: their PSDs, worst axis by RMS, in g^2/Hz.  ``ax``:
+    the two matplotlib axes to draw into (default: a new figure).
     """
-    fig = new_figure(7.5, 7.0)
-    ax1, ax2 = fig.subplots(2, 1)
+    fig, grid = figure_grid(ax, 2, 1, width_in=7.5, height_in=7.0)
+    ax1, ax2 = grid[:, 0]
     ax1.set_title(title or f"{labels[0]} and {labels[1]} vs {prediction.requirement}")
     _bands_on(ax1, prediction.third_octave, prediction.axes, "o-", f"{labels[0]} ")
     _bands_on(ax1, measurement.third_octave, measurement.axes, "s--", f"{labels[1]} ")
@@ -257,4 +275,4 @@ def plot_overlay(
     ax2.set_ylabel("PSD [g^2/Hz]")
     ax2.grid(True, which="both", alpha=0.3)
     ax2.legend(fontsize=8)
-    return finish(fig, hspace=0.65)
+    return fig

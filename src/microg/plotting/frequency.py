@@ -2,7 +2,9 @@
 
 FRFs, harmonic lines, band RMS, contributions, allocations.
 
-Figures are built with ``matplotlib.figure.Figure`` (no pyplot, no backend switch).
+Figures are built with ``matplotlib.figure.Figure`` (no pyplot, no backend switch); every
+plot function takes ``ax=``, the matplotlib axes to draw into (default: a new figure), and
+returns the figure.
 """
 
 from __future__ import annotations
@@ -30,20 +32,14 @@ __all__ = [
 _FLOOR = 1e-30
 
 
-def _figure(title: str) -> Any:
-    from microg.plotting.common import new_figure
+def _figure(ax: Any, title: str) -> Any:
+    """The figure and axes to draw into (the caller's ``ax`` or a new one), titled."""
+    from microg.plotting.common import figure_axes
 
-    fig = new_figure(7.5, 4.5)
-    ax = fig.add_subplot()
+    fig, ax = figure_axes(ax, 7.5, 4.5)
     if title:
         ax.set_title(title)
     return fig, ax
-
-
-def _finish(fig: Any, **margins: float) -> Any:
-    from microg.plotting.common import finish
-
-    return finish(fig, **margins)
 
 
 def _pick(points: tuple[str, ...], point: str | None) -> int:
@@ -56,10 +52,12 @@ def _pick(points: tuple[str, ...], point: str | None) -> int:
     return points.index(point)
 
 
-def plot_frf(frf: AccelerationFRF, *, point: str | None = None, title: str = "") -> Any:
+def plot_frf(
+    frf: AccelerationFRF, *, point: str | None = None, title: str = "", ax: Any = None
+) -> Any:
     """|acceleration FRF| per axis, in micro-g per newton against Hz (log-log)."""
     i = _pick(frf.points, point)
-    fig, ax = _figure(title or f"Acceleration FRF at {frf.points[i]} per N at {frf.at}")
+    fig, ax = _figure(ax, title or f"Acceleration FRF at {frf.points[i]} per N at {frf.at}")
     f = frf.freq_hz
     keep = f > 0
     for k, a in enumerate(frf.axes):
@@ -69,13 +67,15 @@ def plot_frf(frf: AccelerationFRF, *, point: str | None = None, title: str = "")
     ax.set_ylabel("|acceleration| per force [micro-g/N]")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
-    return _finish(fig)
+    return fig
 
 
-def plot_harmonic(resp: HarmonicResponse, *, point: str | None = None, title: str = "") -> Any:
+def plot_harmonic(
+    resp: HarmonicResponse, *, point: str | None = None, title: str = "", ax: Any = None
+) -> Any:
     """Steady-state acceleration amplitude of each line per axis (micro-g, stems)."""
     i = _pick(resp.points, point)
-    fig, ax = _figure(title or f"Harmonic response at {resp.points[i]}")
+    fig, ax = _figure(ax, title or f"Harmonic response at {resp.points[i]}")
     for k, a in enumerate(resp.axes):
         amp = np.abs(resp.accel_mps2[i, k]) / G0 * 1e6
         ax.semilogy(resp.freq_hz, np.maximum(amp, _FLOOR), "o", label=a, ms=4)
@@ -83,13 +83,15 @@ def plot_harmonic(resp: HarmonicResponse, *, point: str | None = None, title: st
     ax.set_ylabel("amplitude [micro-g]")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
-    return _finish(fig)
+    return fig
 
 
-def plot_band_response(resp: BandResponse, *, point: str | None = None, title: str = "") -> Any:
+def plot_band_response(
+    resp: BandResponse, *, point: str | None = None, title: str = "", ax: Any = None
+) -> Any:
     """Band RMS per axis (micro-g) against band centre (log-log)."""
     i = _pick(resp.points, point)
-    fig, ax = _figure(title or f"1/3-octave band RMS at {resp.points[i]}")
+    fig, ax = _figure(ax, title or f"1/3-octave band RMS at {resp.points[i]}")
     for k, a in enumerate(resp.axes):
         rms = resp.rms_mps2[i, k] / G0 * 1e6
         ax.loglog(resp.center_hz, np.maximum(rms, _FLOOR), marker="o", ms=3, lw=0.8, label=a)
@@ -97,15 +99,17 @@ def plot_band_response(resp: BandResponse, *, point: str | None = None, title: s
     ax.set_ylabel("band RMS [micro-g]")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
-    return _finish(fig)
+    return fig
 
 
-def plot_vibratory(va: VibratoryAssessment, *, point: str | None = None, title: str = "") -> Any:
+def plot_vibratory(
+    va: VibratoryAssessment, *, point: str | None = None, title: str = "", ax: Any = None
+) -> Any:
     """Band RMS per axis against the requirement's limit (micro-g, log-log)."""
     i = _pick(va.points, point)
     verdict = "complies" if va.complies[i] else "exceeds"
     fig, ax = _figure(
-        title or f"Vibratory environment at {va.points[i]} vs {va.requirement} ({verdict})"
+        ax, title or f"Vibratory environment at {va.points[i]} vs {va.requirement} ({verdict})"
     )
     top = max(float(np.max(va.rms_g[i], initial=0.0)), float(np.max(va.limit_g)))
     for k, a in enumerate(va.axes):
@@ -123,16 +127,16 @@ def plot_vibratory(va: VibratoryAssessment, *, point: str | None = None, title: 
     ax.set_ylabel("band RMS [micro-g]")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
-    return _finish(fig)
+    return fig
 
 
 def plot_contributions(
-    va: VibratoryAssessment, *, point: str | None = None, title: str = ""
+    va: VibratoryAssessment, *, point: str | None = None, title: str = "", ax: Any = None
 ) -> Any:
     """Each source's share of the band mean square, governing axis, stacked bars per band."""
     i = _pick(va.points, point)
     r = va.response
-    fig, ax = _figure(title or f"Source contributions at {va.points[i]} (governing axis)")
+    fig, ax = _figure(ax, title or f"Source contributions at {va.points[i]} (governing axis)")
     gov = va.governing_axis(va.points[i])
     nb = va.center_hz.size
     share = r.source_share[i, gov, np.arange(nb)]  # (nb, ns)
@@ -153,13 +157,13 @@ def plot_contributions(
     ax.grid(True, axis="y", alpha=0.3)
     if r.sources and ax.get_legend_handles_labels()[0]:  # no source drawn: no empty legend
         ax.legend(fontsize="small", ncol=2)
-    return _finish(fig, bottom=1.0)  # room for the slanted band labels
+    return fig
 
 
-def plot_allocation(alloc: Allocation, *, title: str = "") -> Any:
+def plot_allocation(alloc: Allocation, *, title: str = "", ax: Any = None) -> Any:
     """The allowed force RMS per band of a new source (N, log-log); exceeded bands marked."""
     fig, ax = _figure(
-        title or f"Allocation at {alloc.at} for site {alloc.site} ({alloc.requirement})"
+        ax, title or f"Allocation at {alloc.at} for site {alloc.site} ({alloc.requirement})"
     )
     a = alloc.allowed_rms_n
     finite = np.isfinite(a) & (a > 0)
@@ -176,4 +180,4 @@ def plot_allocation(alloc: Allocation, *, title: str = "") -> Any:
     ax.set_ylabel("allowed force RMS per band [N]")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
-    return _finish(fig)
+    return fig

@@ -2,7 +2,9 @@
 
 The percentile plot follows PIMS's ``otorunhist`` box plot: per band, the median as a
 horizontal line across the band, whiskers from the 1st to the 25th and from the 75th to the
-99th percentile at the band centre, and the requirement as steps on the band edges.
+99th percentile at the band centre, and the requirement as steps on the band edges.  Every
+plot function takes ``ax=``, the matplotlib axes to draw into (default: a new figure), and
+returns the figure.
 """
 
 from __future__ import annotations
@@ -10,8 +12,10 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
+from microg.plotting.common import figure_axes, figure_grid
 from microg.plotting.environment import limit_steps
 
 if TYPE_CHECKING:
@@ -34,14 +38,16 @@ __all__ = [
 _UG = 1e6
 
 
-def _fig(title: str, h: float = 4.5) -> tuple[Figure, Any]:
-    fig = Figure(figsize=(7.5, h), layout="constrained")
-    ax = fig.add_subplot()
+def _fig(ax: Axes | None, title: str, h: float = 4.5) -> tuple[Figure, Axes]:
+    """The figure and axes to draw into (the caller's ``ax`` or a new one), titled."""
+    fig, ax = figure_axes(ax, 7.5, h)
     ax.set_title(title)
     return fig, ax
 
 
-def plot_interval_percentiles(res: IntervalBandRMS, *, row: str = "rss", title: str = "") -> Figure:
+def plot_interval_percentiles(
+    res: IntervalBandRMS, *, row: str = "rss", title: str = "", ax: Axes | None = None
+) -> Figure:
     """Percentiles of interval band RMS (one axis or ``rss``) against the requirement steps."""
     rows = res.rows
     if row not in rows:
@@ -53,6 +59,7 @@ def plot_interval_percentiles(res: IntervalBandRMS, *, row: str = "rss", title: 
     b = res.bands
     label = "RSS(x, y, z)" if row == "rss" else f"{row}-axis"
     fig, ax = _fig(
+        ax,
         title
         or f"Band RMS over {res.t_start_s.size} intervals of {res.interval_s:g} s, {label}, "
         f"vs {res.requirement}",
@@ -88,12 +95,19 @@ def plot_interval_percentiles(res: IntervalBandRMS, *, row: str = "rss", title: 
     return fig
 
 
-def plot_interval_stats(res: IntervalStats, *, title: str = "") -> Figure:
-    """Interval minimum, maximum (bars) and mean (line) per axis against time, micro-g."""
+def plot_interval_stats(res: IntervalStats, *, title: str = "", ax: Any = None) -> Figure:
+    """Interval minimum, maximum (bars) and mean (line) per axis against time, micro-g.
+
+    ``ax``: one matplotlib axes per axis of the record (default: a new figure, titled).
+    """
     n = len(res.axes)
-    fig = Figure(figsize=(7.5, 2.2 * n + 0.8), layout="constrained")
-    axs = np.atleast_1d(fig.subplots(n, 1, sharex=True))
-    fig.suptitle(title or "Interval minimum, maximum and mean")
+    new = ax is None
+    fig, grid = figure_grid(ax, n, 1, width_in=7.5, height_in=2.2 * n + 0.8, sharex=True)
+    axs = grid[:, 0]
+    if new:
+        fig.suptitle(title or "Interval minimum, maximum and mean")
+    else:
+        axs[0].set_title(title or "Interval minimum, maximum and mean")
     for i, (ax, name) in enumerate(zip(axs, res.axes, strict=True)):
         ax.fill_between(
             res.t_start_s, res.min_g[:, i] * _UG, res.max_g[:, i] * _UG, step="post", alpha=0.3,
@@ -107,10 +121,12 @@ def plot_interval_stats(res: IntervalStats, *, title: str = "") -> Figure:
     return fig
 
 
-def plot_band_limited_rms(res: BandLimitedRMS, *, title: str = "") -> Figure:
+def plot_band_limited_rms(
+    res: BandLimitedRMS, *, title: str = "", ax: Axes | None = None
+) -> Figure:
     """Band-limited RMS per axis and RSS against time (interval starts), micro-g."""
     lo, hi = res.band_hz
-    fig, ax = _fig(title or f"RMS in {lo:.3g}-{hi:.3g} Hz per {res.interval_s:g}-s interval")
+    fig, ax = _fig(ax, title or f"RMS in {lo:.3g}-{hi:.3g} Hz per {res.interval_s:g}-s interval")
     for i, name in enumerate(res.axes):
         ax.step(res.t_start_s, res.rms_g[:, i] * _UG, where="post", lw=0.9, label=name)
     ax.step(res.t_start_s, res.rss_g * _UG, where="post", color="k", lw=1.2, label="RSS")
@@ -121,14 +137,16 @@ def plot_band_limited_rms(res: BandLimitedRMS, *, title: str = "") -> Figure:
     return fig
 
 
-def plot_spectrogram(res: Spectrogram, *, axis: str | None = None, title: str = "") -> Figure:
+def plot_spectrogram(
+    res: Spectrogram, *, axis: str | None = None, title: str = "", ax: Axes | None = None
+) -> Figure:
     """log10 PSD (g^2/Hz) against time and frequency for one axis."""
     if axis is None:
         i = int(np.argmax(res.psd_g2_per_hz.sum(axis=(1, 2))))
     else:
         i = list(res.axes).index(axis)
     fig, ax = _fig(
-        title or f"Spectrogram, {res.axes[i]}-axis (Hann, {res.segment_s:.3g}-s segments)"
+        ax, title or f"Spectrogram, {res.axes[i]}-axis (Hann, {res.segment_s:.3g}-s segments)"
     )
     z = res.psd_g2_per_hz[i]
     top = float(np.max(z, initial=0.0))
@@ -140,9 +158,9 @@ def plot_spectrogram(res: Spectrogram, *, axis: str | None = None, title: str = 
     return fig
 
 
-def plot_cumulative_rms(res: CumulativeRMS, *, title: str = "") -> Figure:
+def plot_cumulative_rms(res: CumulativeRMS, *, title: str = "", ax: Axes | None = None) -> Figure:
     """Cumulative RMS per axis and RSS against frequency (log x), micro-g."""
-    fig, ax = _fig(title or "Cumulative RMS against frequency")
+    fig, ax = _fig(ax, title or "Cumulative RMS against frequency")
     f = res.freq_hz
     for i, name in enumerate(res.axes):
         ax.semilogx(f, res.rms_g[i] * _UG, lw=0.9, label=name)

@@ -2,7 +2,8 @@
 
 Figure 8 of the report (``M_a`` against ``r^2``), an absorber's, a mount design's and a
 screened mount's curves, and the isolation advice.  They draw the numbers of the result
-objects' ``to_xarray()``; they compute nothing of their own.
+objects' ``to_xarray()``; they compute nothing of their own.  Every plot function takes
+``ax=``, the matplotlib axes to draw into (default: a new figure), and returns the figure.
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from microg.isolation.design import FIGURE8_CURVES
@@ -19,7 +21,7 @@ from microg.isolation.transmissibility import (
     accel_magnification,
     accel_magnification_no_absorber,
 )
-from microg.plotting.common import finish, new_figure
+from microg.plotting.common import envelope, figure_axes, figure_grid
 
 if TYPE_CHECKING:
     from microg.isolation.absorber import AbsorberTuning
@@ -65,6 +67,7 @@ def figure8(
     zeta: float = 0.2,
     r2_max: float = 6.0,
     n_points: int = 3001,
+    ax: Any = None,
 ) -> Figure:
     """Figure 8: six panels of ``M_a`` versus ``r^2`` at ``zeta = 0.2`` (Section 4.2).
 
@@ -82,11 +85,13 @@ def figure8(
         Upper end of the ``r^2`` axis.
     n_points : int
         Samples of ``r^2`` per curve.
+    ax : array of matplotlib.axes.Axes, optional
+        The six axes to draw into, row by row (default: a new 2 x 3 figure, titled).
     """
     r2 = np.linspace(0.0, r2_max, n_points)
     r = np.sqrt(r2)
-    fig = Figure(figsize=(13, 8), layout="constrained")
-    axes = fig.subplots(2, 3, sharex=True, sharey=True)
+    new = ax is None
+    fig, axes = figure_grid(ax, 2, 3, width_in=13, height_in=8, sharex=True, sharey=True)
     base = accel_magnification_no_absorber(r)
     panels: list[tuple[str, list[tuple[float, float, str]]]] = []
     for mu in FIGURE8_CURVES["mu_panels"]:
@@ -110,7 +115,8 @@ def figure8(
         ax.set_xlabel("r^2 = (omega/omega_n)^2")
     for ax in axes[:, 0]:
         ax.set_ylabel("M_a = |U1/U0|")
-    fig.suptitle("Figure 8: acceleration magnification factor (Eq. 4.3 solved)")
+    if new:
+        fig.suptitle("Figure 8: acceleration magnification factor (Eq. 4.3 solved)")
     if path is not None:
         write_png_atomic(fig, path)
     return fig
@@ -125,15 +131,14 @@ def _log_axes(ax: Any, xlabel: str, ylabel: str) -> None:
     ax.legend(fontsize=8)
 
 
-def plot_absorber(tuning: AbsorberTuning) -> Figure:
+def plot_absorber(tuning: AbsorberTuning, *, ax: Axes | None = None) -> Figure:
     """``M_a`` of a tuned absorber against ``r = omega/omega_n``; returns a Figure.
 
     The package alone dashed, the design band shaded and the peak marked.
     """
     ds = tuning.to_xarray()
     r = ds["r"].values
-    fig = new_figure(7.5, 4.2)
-    ax = fig.add_subplot()
+    fig, ax = figure_axes(ax, 7.5, 4.2)
     ax.semilogy(r, ds["Ma"].values, lw=1.3, label=f"absorber (k = {tuning.k:.4g})")
     ax.semilogy(r, ds["Ma_no_absorber"].values, "k--", lw=0.9, label="no absorber")
     ax.plot([tuning.r_peak], [tuning.peak_Ma], "o", color="crimson", label="peak")
@@ -149,31 +154,29 @@ def plot_absorber(tuning: AbsorberTuning) -> Figure:
     )
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
-    return finish(fig)
+    return fig
 
 
-def plot_mount_design(design: MountDesign) -> Figure:
+def plot_mount_design(design: MountDesign, *, ax: Axes | None = None) -> Figure:
     """A mount design's ``M_a`` against support frequency (Hz); returns a Figure.
 
     The disturbance band shaded and the target drawn.
     """
     ds = design.to_xarray()
-    fig = new_figure(7.5, 4.2)
-    ax = fig.add_subplot()
+    fig, ax = figure_axes(ax, 7.5, 4.2)
     ax.plot(ds["freq_hz"].values, ds["Ma"].values, lw=1.3, label="M_a")
     ax.axvspan(*design.band_hz, color="0.85", alpha=0.5, lw=0, label="disturbance band")
     ax.axhline(design.target, color="crimson", ls="--", lw=1.0, label="target")
     ax.axvline(design.freq_hz_n, color="0.5", lw=0.6, ls=":", label="natural frequency")
     ax.set_title(f"Mount k1 = {design.k1:.4g} N/m, f_n = {design.freq_hz_n:.3g} Hz", fontsize=10)
     _log_axes(ax, "support frequency [Hz]", "M_a = |U1/U0|")
-    return finish(fig)
+    return fig
 
 
-def plot_mount_choice(choice: MountChoice) -> Figure:
+def plot_mount_choice(choice: MountChoice, *, ax: Axes | None = None) -> Figure:
     """A screened spring-damper mount's ``|U1/U0|`` against frequency (Hz); returns a Figure."""
     ds = choice.to_xarray()
-    fig = new_figure(7.5, 4.2)
-    ax = fig.add_subplot()
+    fig, ax = figure_axes(ax, 7.5, 4.2)
     ax.plot(ds["freq_hz"].values, ds["transmissibility"].values, lw=1.3, label="|U1/U0|")
     ax.axvline(choice.freq_hz_n, color="0.5", lw=0.6, ls=":", label="natural frequency")
     ax.axhline(1.0, color="0.5", lw=0.6)
@@ -183,23 +186,22 @@ def plot_mount_choice(choice: MountChoice) -> Figure:
         fontsize=10,
     )
     _log_axes(ax, "support frequency [Hz]", "transmissibility |U1/U0|")
-    return finish(fig)
+    return fig
 
 
-def plot_isolation_advice(advice: IsolationAdvice) -> Figure:
+def plot_isolation_advice(advice: IsolationAdvice, *, ax: Axes | None = None) -> Figure:
     """The largest ``M_a`` each exceeding band allows against the mounts'; returns a Figure.
 
     The allowed ``M_a`` is 1 / attenuation needed; the mounts' are the report-rule design's
     ``M_a`` and the screened mount's ``|U1/U0|``.
     """
     ds = advice.to_xarray()
-    fig = new_figure(7.5, 4.2)
-    ax = fig.add_subplot()
+    fig, ax = figure_axes(ax, 7.5, 4.2)
     ax.set_title(f"Isolation at {advice.point}: {advice.status}", fontsize=10)
     if ds.sizes["center_hz"] == 0 and ds.sizes["freq_hz"] == 0:
         ax.text(0.5, 0.5, advice.note or advice.status, ha="center", va="center", wrap=True)
         ax.set_axis_off()
-        return finish(fig)
+        return fig
     f = ds["freq_hz"].values
     if "design_Ma" in ds:
         ax.plot(f, ds["design_Ma"].values, lw=1.2, label="report-rule design M_a")
@@ -215,10 +217,10 @@ def plot_isolation_advice(advice: IsolationAdvice) -> Figure:
             label="largest M_a allowed (1 / attenuation needed)",
         )
     _log_axes(ax, "frequency [Hz]", "magnification")
-    return finish(fig)
+    return fig
 
 
-def plot_package_response(response: Any, *, title: str = "") -> Figure:
+def plot_package_response(response: Any, *, title: str = "", ax: Axes | None = None) -> Figure:
     """Mount (support) and isolated-package accelerations against time, in micro-g.
 
     Parameters
@@ -226,17 +228,17 @@ def plot_package_response(response: Any, *, title: str = "") -> Figure:
     response : IsolationTimeResponse
         ``timepts`` in s, ``mount_accel`` and ``package_accel`` in m/s^2.
     title : str, optional
+    ax : matplotlib.axes.Axes, optional
+        Where to draw (default: a new figure).
 
     Returns
     -------
     matplotlib.figure.Figure
     """
-    from microg.plotting.common import envelope
     from microg.units import G0
 
     t = np.asarray(response.timepts, float)
-    fig = new_figure(7.5, 3.8)
-    ax = fig.subplots()
+    fig, ax = figure_axes(ax, 7.5, 3.8)
     ax.plot(*envelope(t, np.asarray(response.mount_accel) / G0 * 1e6), lw=0.8, label="mount")
     ax.plot(*envelope(t, np.asarray(response.package_accel) / G0 * 1e6), lw=0.8, label="package")
     ax.set_xlabel("time [s]")
@@ -248,4 +250,4 @@ def plot_package_response(response: Any, *, title: str = "") -> Figure:
     )
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)
-    return finish(fig)
+    return fig

@@ -20,10 +20,11 @@ if TYPE_CHECKING:
 __all__ = ["plot_conclusion7", "plot_layout", "plot_map"]
 
 
-def _figure(width: float, height: float) -> Any:
-    from microg.plotting.common import new_figure
+def _figure(ax: Any, width: float, height: float) -> Any:
+    """The figure and axes to draw into: the caller's ``ax``, or a new figure of this size."""
+    from microg.plotting.common import figure_axes
 
-    return new_figure(width, height, layout="constrained")
+    return figure_axes(ax, width, height)
 
 
 def plot_map(
@@ -32,6 +33,7 @@ def plot_map(
     measure: str = "total",
     title: str | None = None,
     best: Location | None = None,
+    ax: Any = None,
 ) -> Any:
     """The map drawn on the structure: lines in the view plane, colour = log10 peak (g).
 
@@ -46,6 +48,8 @@ def plot_map(
         The map's measure drawn (see :meth:`AccelerationMap.measure`).
     title : str, optional
     best : Location, optional
+    ax : matplotlib.axes.Axes, optional
+        Where to draw (default: a new figure).
 
     Returns
     -------
@@ -64,8 +68,7 @@ def plot_map(
     vmax = float(logv[finite].max()) if np.any(finite) else -6.0
     if vmax <= vmin:
         vmin, vmax = vmin - 0.5, vmax + 0.5
-    fig = _figure(7.5, 6.0)
-    ax = fig.add_subplot()
+    fig, ax = _figure(ax, 7.5, 6.0)
     norm = Normalize(vmin, vmax)
     for line in amap.lines:
         xy = amap.positions[line.index][:, ax_idx]
@@ -126,19 +129,20 @@ def plot_map(
     return fig
 
 
-def plot_layout(result: LayoutResult) -> Any:
+def plot_layout(result: LayoutResult, *, ax: Any = None) -> Any:
     """Peaks at the experiment site before and after the optimiser (bars, log scale, g).
 
     Parameters
     ----------
     result : LayoutResult
+    ax : matplotlib.axes.Axes, optional
+        Where to draw (default: a new figure).
 
     Returns
     -------
     matplotlib.figure.Figure
     """
-    fig = _figure(7.5, 4.5)
-    ax = fig.add_subplot()
+    fig, ax = _figure(ax, 7.5, 4.5)
     a, b = result.initial_peak, result.optimal_peak
     labels = ["total", "rigid", "elastic"]
     before = [a.total_mps2, a.rigid_mps2, a.elastic_mps2]
@@ -167,19 +171,20 @@ def plot_layout(result: LayoutResult) -> Any:
     return fig
 
 
-def plot_conclusion7(c7: Conclusion7) -> Any:
+def plot_conclusion7(c7: Conclusion7, *, ax: Any = None) -> Any:
     """Figure 9 recomputed: elastic and total peak along the main body, with and without orbiter.
 
     Parameters
     ----------
     c7 : Conclusion7
+    ax : matplotlib.axes.Axes, optional
+        Where to draw (default: a new figure).
 
     Returns
     -------
     matplotlib.figure.Figure
     """
-    fig = _figure(7.5, 4.8)
-    ax = fig.add_subplot()
+    fig, ax = _figure(ax, 7.5, 4.8)
     for case, color in ((c7.orbiter, "C0"), (c7.no_orbiter, "C1")):
         amap = case.amap
         sel = amap.component == case.body

@@ -10,12 +10,15 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from matplotlib.axes import Axes
 from matplotlib.figure import Figure
+
+from microg.plotting.common import envelope, figure_axes
 
 __all__ = ["plot_modal_response", "plot_modes"]
 
 
-def plot_modes(modes: Any, *, title: str | None = None) -> Figure:
+def plot_modes(modes: Any, *, title: str | None = None, ax: Axes | None = None) -> Figure:
     """Stem chart of the frequencies of ``modes`` (a :class:`~microg.dynamics.modes.Modes`).
 
     Parameters
@@ -24,13 +27,14 @@ def plot_modes(modes: Any, *, title: str | None = None) -> Figure:
         omega in rad/s; rigid, unstable and growth_rate as documented there.
     title : str, optional
         Figure title (default: method and the number of rigid modes).
+    ax : matplotlib.axes.Axes, optional
+        Where to draw (default: a new figure).
 
     Returns
     -------
     matplotlib.figure.Figure
     """
-    fig = Figure(figsize=(7.5, 4.0), layout="constrained")
-    ax = fig.add_subplot()
+    fig, ax = figure_axes(ax, 7.5, 4.0)
     number = np.arange(1, modes.n_modes + 1)
     el = np.asarray(modes.elastic, bool)
     unstable = np.asarray(modes.unstable, bool)
@@ -53,7 +57,9 @@ def plot_modes(modes: Any, *, title: str | None = None) -> Figure:
     return fig
 
 
-def plot_modal_response(response: Any, *, n_show: int = 6, title: str = "") -> Figure:
+def plot_modal_response(
+    response: Any, *, n_show: int = 6, title: str = "", ax: Axes | None = None
+) -> Figure:
     """Modal accelerations against time: the ``n_show`` modes with the largest peak.
 
     Parameters
@@ -64,19 +70,18 @@ def plot_modal_response(response: Any, *, n_show: int = 6, title: str = "") -> F
     n_show : int
         Modes drawn (the others are listed by count in the title).
     title : str, optional
+    ax : matplotlib.axes.Axes, optional
+        Where to draw (default: a new figure).
 
     Returns
     -------
     matplotlib.figure.Figure
     """
-    from microg.plotting.common import envelope, finish, new_figure
-
     acc = np.atleast_2d(np.asarray(response.eta_ddot, float))
     t = np.asarray(response.timepts, float)
     peak = np.max(np.abs(acc), axis=1) if acc.size else np.zeros(acc.shape[0])
     order = np.argsort(-peak, kind="stable")[: max(int(n_show), 0)]
-    fig = new_figure(7.5, 4.0)
-    ax = fig.subplots()
+    fig, ax = figure_axes(ax, 7.5, 4.0)
     for j in order:
         ax.plot(*envelope(t, acc[j]), lw=0.8, label=f"mode {j + 1}")
     ax.set_xlabel("time [s]")
@@ -90,4 +95,4 @@ def plot_modal_response(response: Any, *, n_show: int = 6, title: str = "") -> F
     ax.grid(True, alpha=0.3)
     if order.size:
         ax.legend(fontsize=8)
-    return finish(fig)
+    return fig

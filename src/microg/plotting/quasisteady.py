@@ -14,6 +14,7 @@ import numpy as np
 from matplotlib.colors import LogNorm
 from matplotlib.figure import Figure
 
+from microg.plotting.common import figure_grid
 from microg.units import G0
 
 __all__ = ["plot_quasi_steady_map"]
@@ -28,15 +29,18 @@ def _limits(values: np.ndarray, cm: float) -> tuple[float, float]:
     return lo - pad, hi + pad
 
 
-def plot_quasi_steady_map(result: Any) -> Figure:
+def plot_quasi_steady_map(result: Any, *, ax: Any = None) -> Figure:
     """The peak quasi-steady magnitude over the structure and the 1 micro-g zone; a Figure.
 
     Parameters
     ----------
     result : microg.environment.quasisteady.QuasiSteadyResult
+    ax : pair of matplotlib.axes.Axes, optional
+        The side and front views' axes (default: a new figure, titled).
     """
-    fig = Figure(figsize=(10.0, 4.8), layout="constrained")
-    axes = fig.subplots(1, 2)
+    new = ax is None
+    fig, grid = figure_grid(ax, 1, 2, width_in=10.0, height_in=4.8)
+    axes = grid[0]
     cm = np.asarray(result.center_of_mass_m, float)
     limit_ug = result.requirement.limit_g * 1e6
     qmap = result.map
@@ -101,8 +105,9 @@ def plot_quasi_steady_map(result: Any) -> Figure:
         fig.colorbar(
             sc, ax=list(axes), label="peak quasi-steady magnitude over the orbit (micro-g)"
         )
-    fig.suptitle(
-        f"{result.model}: quasi-steady acceleration, {result.attitude.kind} attitude; "
-        f"shaded: within {limit_ug:g} micro-g (contour in the plane through the CM)"
-    )
+    if new:
+        fig.suptitle(
+            f"{result.model}: quasi-steady acceleration, {result.attitude.kind} attitude; "
+            f"shaded: within {limit_ug:g} micro-g (contour in the plane through the CM)"
+        )
     return fig

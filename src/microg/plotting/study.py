@@ -1,6 +1,8 @@
 """Figures of a sweep: the margin heat map, the complying fraction per axis, the worst bands.
 
 They read a :class:`~microg.study.summary.Summary` only (figures are built without pyplot).
+Every figure function takes ``ax=``, the matplotlib axes to draw into (default: a new
+figure), and returns the figure.
 """
 
 from __future__ import annotations
@@ -9,8 +11,11 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from matplotlib.axes import Axes
 from matplotlib.colors import TwoSlopeNorm
 from matplotlib.figure import Figure
+
+from microg.plotting.common import figure_axes, figure_grid
 
 if TYPE_CHECKING:
     from microg.study.summary import Summary
@@ -31,7 +36,7 @@ def _ticks(ax: Any, n: int, labels: Sequence[object], axis: str) -> None:
         ax.set_yticks(pos, text, fontsize=7)
 
 
-def heatmap_figure(summary: Summary) -> Figure:
+def heatmap_figure(summary: Summary, *, ax: Axes | None = None) -> Figure:
     """Worst margin (log10 of limit / band RMS, min over the other axes) over two axes.
 
     Below 0 (red) some case does not comply; NaN cells (grey) were not computed.
@@ -45,8 +50,7 @@ def heatmap_figure(summary: Summary) -> Figure:
     span = float(np.max(np.abs(finite))) if finite.size else 1.0
     span = max(span, 1e-3)
     v = np.clip(v, -span, span)
-    fig = Figure(figsize=(7.5, max(3.2, 0.9 + 0.22 * len(lab1))), layout="constrained")
-    ax = fig.subplots()
+    fig, ax = figure_axes(ax, 7.5, max(3.2, 0.9 + 0.22 * len(lab1)))
     cmap = _cmap()
     im = ax.imshow(np.ma.masked_invalid(v), cmap=cmap, aspect="auto",
                    norm=TwoSlopeNorm(0.0, -span, span), interpolation="nearest")  # fmt: skip
@@ -72,12 +76,15 @@ def _cmap() -> Any:
     return matplotlib.colormaps["RdYlGn"].with_extremes(bad="0.85")
 
 
-def fraction_figure(summary: Summary) -> Figure:
-    """The complying fraction for each value of every axis that varies."""
+def fraction_figure(summary: Summary, *, ax: Any = None) -> Figure:
+    """The complying fraction for each value of every axis that varies.
+
+    ``ax``: one matplotlib axes per axis that varies (one when none does).
+    """
     dims = [d for d, v in summary.fraction_by.items() if len(v) > 1]
     n = max(1, len(dims))
-    fig = Figure(figsize=(7.5, 1.0 + 1.7 * n), layout="constrained")
-    axes = np.atleast_1d(fig.subplots(n, 1))
+    fig, grid = figure_grid(ax, n, 1, width_in=7.5, height_in=1.0 + 1.7 * n)
+    axes = grid[:, 0]
     if not dims:
         axes[0].text(0.5, 0.5, "every axis has one value", ha="center", va="center")
         axes[0].set_axis_off()
@@ -95,10 +102,9 @@ def fraction_figure(summary: Summary) -> Figure:
     return fig
 
 
-def worst_bands_figure(summary: Summary) -> Figure:
+def worst_bands_figure(summary: Summary, *, ax: Axes | None = None) -> Figure:
     """Band RMS of the worst case of each observed point (governing axis) against the limit."""
-    fig = Figure(figsize=(7.5, 4.2), layout="constrained")
-    ax = fig.subplots()
+    fig, ax = figure_axes(ax, 7.5, 4.2)
     limit = None
     for name, b in summary.worst_bands.items():
         rms = np.asarray(b["rms_g"], float)

@@ -23,7 +23,6 @@ __all__ = [
     "DEFAULT_FUNCTIONS",
     "METHODS",
     "PLANES",
-    "STATION_MODULES",
     "discretize",
 ]
 
@@ -32,12 +31,6 @@ DEFAULT_ELEMENTS = 10
 #: assumed functions per beam and deformation kind (1 is the report's model)
 DEFAULT_FUNCTIONS = 1
 METHODS = ("fem", "ritz")
-#: the modules that build a station's structure by each method and solve its modes (scipy's
-#: among them, loaded on first use): a caller reading the model in another process imports
-#: them meanwhile (:mod:`microg.cli._load`)
-STATION_MODULES = {
-    method: (f"microg.structure.{method}", "scipy.sparse", "scipy.linalg") for method in METHODS
-}
 PLANES = ("3d", "xz", "yz")
 
 
