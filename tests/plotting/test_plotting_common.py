@@ -125,19 +125,30 @@ def test_without_axes_a_new_figure_is_made_and_saved_as_matplotlib_saves_it(resu
     assert ours.shape == theirs.shape and np.array_equal(ours, theirs)
 
 
+#: public names of the figure modules that draw no figure
+NOT_FIGURES = {
+    "KINDS",
+    "active_figures",
+    "limit_steps",
+    "live_axes",
+    "sample_displacements",
+    "write_png_atomic",
+}
+
+
 def test_every_plot_function_takes_ax():
     # reference: the signatures of the public plot functions of every figure module
     import importlib
 
-    names = ["analysis", "environment", "frequency", "intervals", "isolation", "location"]
-    names += ["modes", "quasisteady", "seed", "study"]
+    names = ["active", "analysis", "environment", "frequency", "intervals", "isolation"]
+    names += ["location", "modes", "quasisteady", "seed", "study"]
     missing = []
     for name in names:
         mod = importlib.import_module(f"microg.plotting.{name}")
         for fn_name in mod.__all__:
             fn = getattr(mod, fn_name)
-            if fn_name in ("limit_steps", "live_axes", "sample_displacements", "write_png_atomic"):
-                continue  # not figures
+            if fn_name in NOT_FIGURES:
+                continue
             if "ax" not in inspect.signature(fn).parameters:
                 missing.append(f"{name}.{fn_name}")
     assert missing == []

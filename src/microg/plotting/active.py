@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from microg.plotting.common import new_figure, png_bytes
+from microg.plotting.common import figure_axes, figure_grid, png_bytes
 from microg.units import G0
 
 if TYPE_CHECKING:
@@ -26,10 +26,7 @@ _AXES = ("x", "y", "z")
 
 
 def _axes(ax: Any, width: float = 7.5, height: float = 4.4) -> tuple[Figure, Any]:
-    if ax is not None:
-        return ax.figure, ax
-    fig = new_figure(width, height, layout="constrained")
-    return fig, fig.add_subplot()
+    return figure_axes(ax, width, height)
 
 
 def _transmissibility(res: ActiveIsolation, ax: Any) -> Figure:
@@ -95,8 +92,8 @@ def _time(res: ActiveIsolation, ax: Any) -> Figure:
             return fig
         axs = [ax]
     else:
-        fig = new_figure(7.5, 7.0, layout="constrained")
-        axs = list(fig.subplots(3, 1, sharex=True))
+        fig, grid = figure_grid(None, 3, 1, width_in=7.5, height_in=7.0, sharex=True)
+        axs = list(grid[:, 0])
     t = tm.timepts
     j = int(np.argmax(np.max(np.abs(tm.base_accel), axis=1)))
     axs[0].plot(
