@@ -527,3 +527,32 @@ def test_inventory_of_result_types():
     # by name in the report rather than here
     unknown = {q for q in unknown if not q.startswith(("microg.analysis.", "microg.study."))}
     assert not unknown, f"public dataclasses not classified: {sorted(unknown)}"
+
+
+def test_every_plot_takes_the_callers_axes():
+    """Every result's ``.plot`` has ``ax=`` (the matplotlib axes to draw into)."""
+    found = _public_dataclasses()
+    lacking = [
+        qual
+        for qual, methods in CONTRACT.items()
+        if "plot" in methods and "ax" not in inspect.signature(found[qual].plot).parameters
+    ]
+    assert lacking == []
+
+
+def test_a_plot_draws_into_the_callers_axes(assessment, advice):
+    # reference: the caller's own figure and axes; the lines drawn are the result's numbers
+    from matplotlib.figure import Figure as MplFigure
+
+    from microg.environment.requirements import iss_requirement
+
+    req = iss_requirement()
+    fig = MplFigure()
+    left, right = fig.subplots(1, 2)
+    assert req.plot(ax=left) is fig
+    assert assessment.plot(kind="psd", ax=right) is fig
+    assert fig.axes == [left, right]  # nothing added: both drawn where the caller said
+    x = np.column_stack([req.bands.lower_hz, req.bands.upper_hz]).ravel()
+    assert _drawn(fig, x, np.repeat(req.limit_g, 2) * 1e6)
+    assert right.get_xscale() == "log" and right.get_lines()
+    assert advice.plot(ax=left) is fig  # a second drawing into the same axes

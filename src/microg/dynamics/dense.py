@@ -68,6 +68,8 @@ RESIDUAL_TOL = 1e-8
 SUPPORT_CANCEL = 1e-6
 #: most levels of the graded solve (each resolves at least four decades of the spectrum)
 MAX_LEVELS = 24
+
+
 @dataclass(frozen=True)
 class Eigensolution:
     """Modes of a free-free pencil ``K phi = lambda M phi``, rigid ones first.

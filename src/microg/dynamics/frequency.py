@@ -230,11 +230,14 @@ class AccelerationFRF:
             attrs={"units": "(m/s^2)/N", "at": self.at, "direction": list(self.direction)},
         )
 
-    def plot(self, point: str | None = None) -> Any:
-        """Magnitude of the FRF per axis (log-log); returns a matplotlib Figure."""
+    def plot(self, point: str | None = None, ax: Any = None) -> Any:
+        """Magnitude of the FRF per axis (log-log); returns a matplotlib Figure.
+
+        ``ax``: the matplotlib axes to draw into (default: a new figure).
+        """
         from microg.plotting.frequency import plot_frf
 
-        return plot_frf(self, point=point)
+        return plot_frf(self, point=point, ax=ax)
 
 
 def frf(
@@ -330,11 +333,14 @@ class HarmonicResponse:
             },
         )
 
-    def plot(self, point: str | None = None) -> Any:
-        """Amplitude of each line per axis; returns a matplotlib Figure."""
+    def plot(self, point: str | None = None, ax: Any = None) -> Any:
+        """Amplitude of each line per axis; returns a matplotlib Figure.
+
+        ``ax``: the matplotlib axes to draw into (default: a new figure).
+        """
         from microg.plotting.frequency import plot_harmonic
 
-        return plot_harmonic(self, point=point)
+        return plot_harmonic(self, point=point, ax=ax)
 
 
 def harmonic_response(
@@ -495,11 +501,14 @@ class BandResponse:
             attrs={"quad_nodes": self.quad_nodes, "warnings": "; ".join(self.warnings)},
         )
 
-    def plot(self, point: str | None = None) -> Any:
-        """Band RMS per axis at one point (log-log); returns a matplotlib Figure."""
+    def plot(self, point: str | None = None, ax: Any = None) -> Any:
+        """Band RMS per axis at one point (log-log); returns a matplotlib Figure.
+
+        ``ax``: the matplotlib axes to draw into (default: a new figure).
+        """
         from microg.plotting.frequency import plot_band_response
 
-        return plot_band_response(self, point=point)
+        return plot_band_response(self, point=point, ax=ax)
 
 
 def _shares(share: np.ndarray, total: np.ndarray) -> np.ndarray:

@@ -237,11 +237,14 @@ class Modes:
             attrs={"method": self.method, "notes": "; ".join(self.notes)},
         )
 
-    def plot(self, **kwargs: Any) -> Any:
-        """A stem chart of the frequencies (:func:`microg.plotting.modes.plot_modes`)."""
+    def plot(self, ax: Any = None, **kwargs: Any) -> Any:
+        """A stem chart of the frequencies (:func:`microg.plotting.modes.plot_modes`).
+
+        ``ax``: the matplotlib axes to draw into (default: a new figure).
+        """
         from microg.plotting.modes import plot_modes
 
-        return plot_modes(self, **kwargs)
+        return plot_modes(self, ax=ax, **kwargs)
 
 
 def effective_mass(

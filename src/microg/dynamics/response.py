@@ -113,11 +113,14 @@ class ModalResponse:
             },
         )
 
-    def plot(self, n_show: int = 6) -> Any:
-        """The modal accelerations of the ``n_show`` modes with the largest peak (a Figure)."""
+    def plot(self, n_show: int = 6, ax: Any = None) -> Any:
+        """The modal accelerations of the ``n_show`` modes with the largest peak (a Figure).
+
+        ``ax``: the matplotlib axes to draw into (default: a new figure).
+        """
         from microg.plotting.modes import plot_modal_response
 
-        return plot_modal_response(self, n_show=n_show)
+        return plot_modal_response(self, n_show=n_show, ax=ax)
 
 
 def _row_peaks(a: np.ndarray) -> list[float]:
@@ -187,12 +190,15 @@ class PointResponse:
             attrs={"point": self.name},
         )
 
-    def plot(self) -> Any:
-        """The acceleration history, micro-g against s (a Figure)."""
+    def plot(self, ax: Any = None) -> Any:
+        """The acceleration history, micro-g against s (a Figure).
+
+        ``ax``: the matplotlib axes to draw into (default: a new figure).
+        """
         from microg.plotting.environment import plot_time_history
 
         return plot_time_history(
-            self.timepts, self.acceleration, title=f"Acceleration at {self.name}"
+            self.timepts, self.acceleration, title=f"Acceleration at {self.name}", ax=ax
         )
 
 

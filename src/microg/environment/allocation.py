@@ -147,11 +147,14 @@ class Allocation:
             },
         )
 
-    def plot(self) -> Any:
-        """The allowed force RMS per band (log-log); returns a matplotlib Figure."""
+    def plot(self, ax: Any = None) -> Any:
+        """The allowed force RMS per band (log-log); returns a matplotlib Figure.
+
+        ``ax``: the matplotlib axes to draw into (default: a new figure).
+        """
         from microg.plotting.frequency import plot_allocation
 
-        return plot_allocation(self)
+        return plot_allocation(self, ax=ax)
 
 
 def allocate(

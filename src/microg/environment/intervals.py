@@ -192,11 +192,14 @@ class IntervalBandRMS:
             attrs={"requirement": self.requirement, "interval_s": self.interval_s},
         )
 
-    def plot(self, row: str = "rss") -> Figure:
-        """Percentiles over intervals against the requirement steps (PIMS's box plot)."""
+    def plot(self, row: str = "rss", ax: Any = None) -> Figure:
+        """Percentiles over intervals against the requirement steps (PIMS's box plot).
+
+        ``ax``: the matplotlib axes to draw into (default: a new figure).
+        """
         from microg.plotting.intervals import plot_interval_percentiles
 
-        return plot_interval_percentiles(self, row=row)
+        return plot_interval_percentiles(self, row=row, ax=ax)
 
 
 @dataclass(frozen=True)
@@ -246,11 +249,14 @@ class IntervalStats:
             },
         )
 
-    def plot(self) -> Figure:
-        """Interval min, max and mean against time."""
+    def plot(self, ax: Any = None) -> Figure:
+        """Interval min, max and mean against time.
+
+        ``ax``: the matplotlib axes to draw into (default: a new figure).
+        """
         from microg.plotting.intervals import plot_interval_stats
 
-        return plot_interval_stats(self)
+        return plot_interval_stats(self, ax=ax)
 
 
 @dataclass(frozen=True)
@@ -300,11 +306,14 @@ class BandLimitedRMS:
             attrs={"band_lower_hz": self.band_hz[0], "band_upper_hz": self.band_hz[1]},
         )
 
-    def plot(self) -> Figure:
-        """Band-limited RMS against time."""
+    def plot(self, ax: Any = None) -> Figure:
+        """Band-limited RMS against time.
+
+        ``ax``: the matplotlib axes to draw into (default: a new figure).
+        """
         from microg.plotting.intervals import plot_band_limited_rms
 
-        return plot_band_limited_rms(self)
+        return plot_band_limited_rms(self, ax=ax)
 
 
 @dataclass(frozen=True)
@@ -355,11 +364,14 @@ class Spectrogram:
             attrs={"units": "g^2/Hz", "window": "hann", "segment_s": self.segment_s},
         )
 
-    def plot(self, axis: str | None = None) -> Figure:
-        """The spectrogram of one axis (default: the one with the most power)."""
+    def plot(self, axis: str | None = None, ax: Any = None) -> Figure:
+        """The spectrogram of one axis (default: the one with the most power).
+
+        ``ax``: the matplotlib axes to draw into (default: a new figure).
+        """
         from microg.plotting.intervals import plot_spectrogram
 
-        return plot_spectrogram(self, axis=axis)
+        return plot_spectrogram(self, axis=axis, ax=ax)
 
 
 @dataclass(frozen=True)
@@ -410,11 +422,14 @@ class CumulativeRMS:
             },
         )
 
-    def plot(self) -> Figure:
-        """Cumulative RMS against frequency."""
+    def plot(self, ax: Any = None) -> Figure:
+        """Cumulative RMS against frequency.
+
+        ``ax``: the matplotlib axes to draw into (default: a new figure).
+        """
         from microg.plotting.intervals import plot_cumulative_rms
 
-        return plot_cumulative_rms(self)
+        return plot_cumulative_rms(self, ax=ax)
 
 
 @dataclass(frozen=True)
@@ -497,9 +512,12 @@ class IntervalAnalysis:
         )
         return ds
 
-    def plot(self, row: str = "rss") -> Figure:
-        """The percentiles of interval band RMS against the requirement (PIMS's summary plot)."""
-        return self.bands.plot(row=row)
+    def plot(self, row: str = "rss", ax: Any = None) -> Figure:
+        """The percentiles of interval band RMS against the requirement (PIMS's summary plot).
+
+        ``ax``: the matplotlib axes to draw into (default: a new figure).
+        """
+        return self.bands.plot(row=row, ax=ax)
 
 
 def _interval_spectrum(

@@ -229,12 +229,19 @@ class MeasuredRecord:
             },
         )
 
-    def plot(self, *, title: str = "") -> Figure:
-        """The record against time, micro-g (``plotting.environment.plot_time_history``)."""
+    def plot(self, *, title: str = "", ax: Any = None) -> Figure:
+        """The record against time, micro-g (``plotting.environment.plot_time_history``).
+
+        ``ax``: the matplotlib axes to draw into (default: a new figure).
+        """
         from microg.plotting.environment import plot_time_history
 
         return plot_time_history(
-            self.timepts, self.accel, axes=self.axes, title=title or f"Acceleration at {self.key}"
+            self.timepts,
+            self.accel,
+            axes=self.axes,
+            title=title or f"Acceleration at {self.key}",
+            ax=ax,
         )
 
 

@@ -182,11 +182,14 @@ class Spectrum:
             },
         )
 
-    def plot(self, axes: tuple[str, ...] | None = None) -> Figure:
-        """The PSD, g^2/Hz, log-log (:func:`microg.plotting.environment.plot_psd`)."""
+    def plot(self, axes: tuple[str, ...] | None = None, ax: Any = None) -> Figure:
+        """The PSD, g^2/Hz, log-log (:func:`microg.plotting.environment.plot_psd`).
+
+        ``ax``: the matplotlib axes to draw into (default: a new figure).
+        """
         from microg.plotting.environment import plot_psd
 
-        return plot_psd(self, axes=axis_names(self.psd.shape[0], axes))
+        return plot_psd(self, axes=axis_names(self.psd.shape[0], axes), ax=ax)
 
 
 @dataclass(frozen=True)
@@ -356,11 +359,16 @@ class ThirdOctave:
             {},
         )
 
-    def plot(self, axes: tuple[str, ...] | None = None, *, title: str = "") -> Figure:
-        """Band RMS per axis against the limit steps (``plotting.environment.plot_bands``)."""
+    def plot(
+        self, axes: tuple[str, ...] | None = None, *, title: str = "", ax: Any = None
+    ) -> Figure:
+        """Band RMS per axis against the limit steps (``plotting.environment.plot_bands``).
+
+        ``ax``: the matplotlib axes to draw into (default: a new figure).
+        """
         from microg.plotting.environment import plot_bands
 
-        return plot_bands(self, axes=axis_names(self.rms_g.shape[0], axes), title=title)
+        return plot_bands(self, axes=axis_names(self.rms_g.shape[0], axes), title=title, ax=ax)
 
 
 class _WindowIntegrals:
@@ -415,12 +423,17 @@ class _WindowIntegrals:
             },
         )
 
-    def plot(self, axes: tuple[str, ...] | None = None, *, title: str = "") -> Figure:
-        """Each window's integral against its start (``plotting.environment.plot_integrated``)."""
+    def plot(
+        self, axes: tuple[str, ...] | None = None, *, title: str = "", ax: Any = None
+    ) -> Figure:
+        """Each window's integral against its start (``plotting.environment.plot_integrated``).
+
+        ``ax``: the matplotlib axes to draw into (default: a new figure).
+        """
         from microg.plotting.environment import plot_integrated
 
         me: Any = self  # one of the two subclasses
-        return plot_integrated(me, axes=axis_names(self.delta_v.shape[0], axes), title=title)
+        return plot_integrated(me, axes=axis_names(self.delta_v.shape[0], axes), title=title, ax=ax)
 
 
 @dataclass(frozen=True)
@@ -696,14 +709,17 @@ class Assessment:
             },
         )
 
-    def plot(self, kind: str = "third_octave") -> Figure:
-        """A figure of the assessment: ``third_octave`` (default) or ``psd``."""
+    def plot(self, kind: str = "third_octave", ax: Any = None) -> Figure:
+        """A figure of the assessment: ``third_octave`` (default) or ``psd``.
+
+        ``ax``: the matplotlib axes to draw into (default: a new figure).
+        """
         from microg.plotting.environment import plot_psd, plot_third_octave
 
         if kind == "third_octave":
-            return plot_third_octave(self)
+            return plot_third_octave(self, ax=ax)
         if kind == "psd":
-            return plot_psd(self.spectrum, axes=self.axes)
+            return plot_psd(self.spectrum, axes=self.axes, ax=ax)
         raise InputError(f"unknown plot {kind!r}", where="kind", fix="use third_octave or psd")
 
 

@@ -948,11 +948,14 @@ class QuasiSteadyResult:
             self.attitude.kind == "lvlh",
         )
 
-    def plot(self) -> Figure:
-        """The map of the peak magnitude with the 1 micro-g zone (see microg.plotting)."""
+    def plot(self, ax: Any = None) -> Figure:
+        """The map of the peak magnitude with the 1 micro-g zone (see microg.plotting).
+
+        ``ax``: the matplotlib axes to draw into (default: a new figure).
+        """
         from microg.plotting.quasisteady import plot_quasi_steady_map
 
-        return plot_quasi_steady_map(self)
+        return plot_quasi_steady_map(self, ax=ax)
 
     def to_xarray(self) -> Any:
         """Per-point vectors (orbital averages, m/s^2) as an xarray Dataset."""

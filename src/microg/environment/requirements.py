@@ -114,11 +114,14 @@ class Requirement:
             ds.attrs["peak_limit_g"] = self.peak_limit_g
         return ds
 
-    def plot(self, *, title: str = "") -> Figure:
-        """The limit as steps on the band edges (``plotting.environment.plot_requirement``)."""
+    def plot(self, *, title: str = "", ax: Any = None) -> Figure:
+        """The limit as steps on the band edges (``plotting.environment.plot_requirement``).
+
+        ``ax``: the matplotlib axes to draw into (default: a new figure).
+        """
         from microg.plotting.environment import plot_requirement
 
-        return plot_requirement(self, title=title)
+        return plot_requirement(self, title=title, ax=ax)
 
 
 def third_octave_bands(fmin_hz: float = 0.01, fmax_hz: float = 316.3, base: int = 10) -> BandTable:

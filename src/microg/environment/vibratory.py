@@ -249,18 +249,20 @@ class VibratoryAssessment:
         )
         return out
 
-    def plot(self, point: str | None = None, kind: str = "bands") -> Any:
+    def plot(self, point: str | None = None, kind: str = "bands", ax: Any = None) -> Any:
         """Figure: ``bands`` or ``contributions``.
 
         ``bands``: band RMS per axis against the limit; ``contributions``: each source's
         share of the governing axis per band.
+
+        ``ax``: the matplotlib axes to draw into (default: a new figure).
         """
         from microg.plotting.frequency import plot_contributions, plot_vibratory
 
         if kind == "bands":
-            return plot_vibratory(self, point=point)
+            return plot_vibratory(self, point=point, ax=ax)
         if kind == "contributions":
-            return plot_contributions(self, point=point)
+            return plot_contributions(self, point=point, ax=ax)
         raise InputError(f"unknown plot {kind!r}", where="kind", fix="use bands or contributions")
 
 

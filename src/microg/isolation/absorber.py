@@ -140,11 +140,14 @@ class AbsorberTuning:
             | ({} if self.band is None else {"band_r": list(self.band)}),
         )
 
-    def plot(self) -> Figure:
-        """``M_a`` against ``r``, the band and the peak (``plotting.isolation.plot_absorber``)."""
+    def plot(self, ax: Any = None) -> Figure:
+        """``M_a`` against ``r``, the band and the peak (``plotting.isolation.plot_absorber``).
+
+        ``ax``: the matplotlib axes to draw into (default: a new figure).
+        """
         from microg.plotting.isolation import plot_absorber
 
-        return plot_absorber(self)
+        return plot_absorber(self, ax=ax)
 
     def contract(self) -> dict[str, float | str]:
         """The CLI contract ``{"k", "zeta", "f", "peak_Ma", "criterion"}``."""

@@ -173,11 +173,14 @@ class IsolationAdvice:
             },
         )
 
-    def plot(self) -> Figure:
-        """Attenuation needed per band against the mounts' curves (``plotting.isolation``)."""
+    def plot(self, ax: Any = None) -> Figure:
+        """Attenuation needed per band against the mounts' curves (``plotting.isolation``).
+
+        ``ax``: the matplotlib axes to draw into (default: a new figure).
+        """
         from microg.plotting.isolation import plot_isolation_advice
 
-        return plot_isolation_advice(self)
+        return plot_isolation_advice(self, ax=ax)
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready advice (keys documented in docs/assessment.md)."""

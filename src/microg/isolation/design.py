@@ -168,11 +168,14 @@ class MountDesign:
             | {"omega_band_units": "rad/s", "omega_n_units": "rad/s"},
         )
 
-    def plot(self) -> Figure:
-        """``M_a`` against frequency, the band and the target (``plotting.isolation``)."""
+    def plot(self, ax: Any = None) -> Figure:
+        """``M_a`` against frequency, the band and the target (``plotting.isolation``).
+
+        ``ax``: the matplotlib axes to draw into (default: a new figure).
+        """
         from microg.plotting.isolation import plot_mount_design
 
-        return plot_mount_design(self)
+        return plot_mount_design(self, ax=ax)
 
 
 def _validate_design(mass: float, band: tuple[float, float], target: float) -> None:

@@ -120,11 +120,14 @@ class MountChoice:
             attrs=self.to_dict() | {"found": int(self.found), "mass_kg": self.mass_kg},
         )
 
-    def plot(self) -> Figure:
-        """``|U1/U0|`` against frequency (``plotting.isolation.plot_mount_choice``)."""
+    def plot(self, ax: Any = None) -> Figure:
+        """``|U1/U0|`` against frequency (``plotting.isolation.plot_mount_choice``).
+
+        ``ax``: the matplotlib axes to draw into (default: a new figure).
+        """
         from microg.plotting.isolation import plot_mount_choice
 
-        return plot_mount_choice(self)
+        return plot_mount_choice(self, ax=ax)
 
 
 #: a candidate's power in a band is a Taylor series of ``|T|^2`` about the band's centre of at

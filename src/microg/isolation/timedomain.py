@@ -559,11 +559,14 @@ class IsolationTimeResponse:
             attrs={"peak_ratio": self.peak_ratio, "rms_ratio": self.rms_ratio},
         )
 
-    def plot(self) -> Any:
-        """Mount and package accelerations against time, micro-g (a Figure)."""
+    def plot(self, ax: Any = None) -> Any:
+        """Mount and package accelerations against time, micro-g (a Figure).
+
+        ``ax``: the matplotlib axes to draw into (default: a new figure).
+        """
         from microg.plotting.isolation import plot_package_response
 
-        return plot_package_response(self)
+        return plot_package_response(self, ax=ax)
 
 
 def _rms(t: NDArray[np.float64], y: NDArray[np.float64]) -> float:

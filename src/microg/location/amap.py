@@ -335,11 +335,15 @@ class AccelerationMap:
         measure: str = "total",
         title: str | None = None,
         best: Location | None = None,
+        ax: Any = None,
     ) -> Any:
-        """The map drawn on the structure (:func:`microg.plotting.location.plot_map`)."""
+        """The map drawn on the structure (:func:`microg.plotting.location.plot_map`).
+
+        ``ax``: the matplotlib axes to draw into (default: a new figure).
+        """
         from microg.plotting.location import plot_map
 
-        return plot_map(self, measure=measure, title=title, best=best)
+        return plot_map(self, measure=measure, title=title, best=best, ax=ax)
 
 
 @dataclass(frozen=True)
@@ -500,8 +504,11 @@ class LocateResult:
         ds.attrs["model"] = self.model
         return ds
 
-    def plot(self, *, title: str | None = None) -> Any:
-        """The map with the best location circled (a matplotlib Figure)."""
+    def plot(self, *, title: str | None = None, ax: Any = None) -> Any:
+        """The map with the best location circled (a matplotlib Figure).
+
+        ``ax``: the matplotlib axes to draw into (default: a new figure).
+        """
         from microg.plotting.location import plot_map
 
         return plot_map(
@@ -509,6 +516,7 @@ class LocateResult:
             measure=self.best.measure,
             title=title or f"{self.model}: {self.amap.method}",
             best=self.best,
+            ax=ax,
         )
 
 

@@ -234,11 +234,14 @@ class LayoutResult:
             },
         )
 
-    def plot(self) -> Any:
-        """Peaks at the site before and after (:func:`microg.plotting.location.plot_layout`)."""
+    def plot(self, ax: Any = None) -> Any:
+        """Peaks at the site before and after (:func:`microg.plotting.location.plot_layout`).
+
+        ``ax``: the matplotlib axes to draw into (default: a new figure).
+        """
         from microg.plotting.location import plot_layout
 
-        return plot_layout(self)
+        return plot_layout(self, ax=ax)
 
 
 # --------------------------------------------------------------------------- the masses

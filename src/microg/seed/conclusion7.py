@@ -149,11 +149,14 @@ class Conclusion7:
             "moved_m": self.moved,
         }
 
-    def plot(self) -> Any:
-        """Figure 9 recomputed (:func:`microg.plotting.location.plot_conclusion7`)."""
+    def plot(self, ax: Any = None) -> Any:
+        """Figure 9 recomputed (:func:`microg.plotting.location.plot_conclusion7`).
+
+        ``ax``: the matplotlib axes to draw into (default: a new figure).
+        """
         from microg.plotting.location import plot_conclusion7
 
-        return plot_conclusion7(self)
+        return plot_conclusion7(self, ax=ax)
 
 
 def conclusion7_case(

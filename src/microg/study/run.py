@@ -148,11 +148,14 @@ class SweepResult:
         """``{"cases", "complying_fraction", "worst", ...}``: the ``--json`` contract."""
         return self.summary().to_dict()
 
-    def plot(self, heatmap: Sequence[str] | None = None) -> Figure:
-        """Heat map of the worst margin over two axes (a Figure)."""
+    def plot(self, heatmap: Sequence[str] | None = None, ax: Any = None) -> Figure:
+        """Heat map of the worst margin over two axes (a Figure).
+
+        ``ax``: the matplotlib axes to draw into (default: a new figure).
+        """
         from microg.plotting.study import heatmap_figure
 
-        return heatmap_figure(self.summary(heatmap=heatmap))
+        return heatmap_figure(self.summary(heatmap=heatmap), ax=ax)
 
     def case_model(self, model: str, variant: str) -> Any:
         """The model object of (model, variant), as the sweep used it."""

@@ -138,11 +138,14 @@ class Summary:
             },
         )
 
-    def plot(self) -> Any:
-        """The heat map of the worst margins (:func:`microg.plotting.study.heatmap_figure`)."""
+    def plot(self, ax: Any = None) -> Any:
+        """The heat map of the worst margins (:func:`microg.plotting.study.heatmap_figure`).
+
+        ``ax``: the matplotlib axes to draw into (default: a new figure).
+        """
         from microg.plotting.study import heatmap_figure
 
-        return heatmap_figure(self)
+        return heatmap_figure(self, ax=ax)
 
 
 def _num(v: float) -> float | str | None:
