@@ -1,6 +1,6 @@
 """Benchmark: the main job's commands as a user runs them, against ``python -c "import numpy"``.
 
-Issue 8 ("Speed of the main job"): each command is run as a fresh subprocess, ``--runs`` times
+Each command is run as a fresh subprocess, ``--runs`` times
 (default 5), round-robin with the baseline so that a machine loaded by other work slows them
 alike; the median wall time of each is printed, with its ratio to the baseline's median:
 
@@ -17,13 +17,10 @@ on a loaded machine they move less than the wall clock.
 Then a per-stage profile of ``microg analyze`` (median over ``--profile-runs`` fresh
 processes, each doing what the command does, stage by stage): imports (what the command loads
 before it computes), model load, structure, modes, response, assessment, exact peaks,
-isolation, figures (build and render), HTML, write; each stage lists the heavy libraries it
+isolation, figures (build and save), HTML, write; each stage lists the heavy libraries it
 loads first.  The stage times add up to the in-process total; the command's own wall time
 adds the interpreter start.  Each profiled process starts as the ``microg`` process does
-(:func:`microg.cli._startup.install`); the serial column draws the figures in-process, the
-helpers column as ``microg analyze`` does (a helper forked before the model load draws the
-model's figures once the modes are solved, then the rest and the HTML page: its "figures"
-time is the caller's wait, and "HTML" is then nothing).
+(:func:`microg.cli.one_blas_thread`: BLAS on one thread unless the environment sets a count).
 
 Run:  .venv/bin/python benchmarks/bench_cli.py            (about 40 s on the 2-core machine)
       .venv/bin/python benchmarks/bench_cli.py --figures  (also the time of each figure)
@@ -65,7 +62,7 @@ WATCH = (
     "numba",
 )
 
-#: ratio targets of issue 8
+#: ratio targets of the main job's speed
 TARGETS = {"import microg": 2.0, "microg modes ioc --json": 4.0, "microg analyze --json": 8.0}
 
 #: libraries ``import microg`` must not load
@@ -170,13 +167,8 @@ def forbidden_imports() -> list[str]:
 # ------------------------------------------------------------------------- stage profile
 
 
-def _profile_child(out_dir: str, per_figure: bool, helpers: bool) -> dict[str, Any]:
-    """One in-process run of what ``microg analyze --json`` does, timed stage by stage.
-
-    ``helpers``: the figures are drawn by :func:`microg.report.analysis.start_renderer`'s
-    helper processes, started where the command starts them (before the computation), the
-    model's figures from the moment the modes are solved (as the command does).
-    """
+def _profile_child(out_dir: str, per_figure: bool) -> dict[str, Any]:
+    """One in-process run of what ``microg analyze --json`` does, timed stage by stage."""
     stamps: list[tuple[str, float, float, set[str]]] = []
 
     def mark(stage: str) -> None:
@@ -185,18 +177,16 @@ def _profile_child(out_dir: str, per_figure: bool, helpers: bool) -> dict[str, A
     t0, c0 = time.perf_counter(), time.process_time()
     mods0 = set(sys.modules)
 
-    from microg.cli._startup import install
-
-    install()  # what the microg process does first (BLAS threads, lazy imports)
-    import microg
     import microg.cli
+
+    microg.cli.one_blas_thread()  # what the microg process does first
+    import microg
     import microg.cli.analyze as cli_analyze
 
     mark("model load")
     import microg.dynamics.superposition as sp
     import microg.report.analysis as rep
 
-    renderer = rep.start_renderer() if helpers else None
     extra: dict[str, float] = {"exact peaks": 0.0, "exact peaks cpu": 0.0}
     figure_times: dict[str, float] = {}
 
@@ -217,48 +207,38 @@ def _profile_child(out_dir: str, per_figure: bool, helpers: bool) -> dict[str, A
         def wrapper(*args: Any, **kwargs: Any) -> Any:
             mark(name)
             try:
-                if name == "figures" and renderer is not None and len(args) < 2:
-                    kwargs.setdefault("renderer", renderer)
                 return fn(*args, **kwargs)
             finally:
                 mark("write")
 
         return wrapper
 
-    def jobs_timed(fn: Any) -> Any:
+    def builders_timed(fn: Any) -> Any:
         def wrapper(result: Any) -> Any:
-            from microg.report.render import FigureJob
-
-            def clock(job: Any) -> Any:
-                def draw() -> bytes:
+            def clock(name: str, build: Any) -> Any:
+                def draw() -> Any:
                     t = time.perf_counter()
                     try:
-                        return bytes(job.draw())
+                        return build()
                     finally:
-                        figure_times[job.name] = time.perf_counter() - t
+                        figure_times[name] = time.perf_counter() - t
 
-                return FigureJob(job.name, job.weight, draw)
+                return draw
 
-            return [clock(j) for j in fn(result)]
+            return {name: clock(name, b) for name, b in fn(result).items()}
 
         return wrapper
 
-    # report_files: the helpers draw the figures and write the page (the caller's wait is
-    # "figures"); in-process, its figures() and render_analysis() are the two stages
-    rep.report_files = staged("figures", rep.report_files)  # type: ignore[assignment]
+    # report_files: figures() (build and save) and render_analysis() are the two stages
     rep.figures = staged("figures", rep.figures)  # type: ignore[assignment]
     rep.render_analysis = staged("HTML", rep.render_analysis)  # type: ignore[assignment]
     if per_figure:
-        rep.figure_jobs = jobs_timed(rep.figure_jobs)  # type: ignore[assignment]
+        rep.figure_builders = builders_timed(rep.figure_builders)  # type: ignore[assignment]
 
-    result = microg.analyze(
-        progress=mark, command="microg analyze --json", on_modes=rep.early_figures(renderer)
-    )
+    result = microg.analyze(progress=mark, command="microg analyze --json")
     mark("write")
-    cli_analyze.write_outputs(result, Path(out_dir), renderer)  # + the JSON --json prints
+    cli_analyze.write_outputs(result, Path(out_dir))  # + the JSON --json prints
     mark("end")
-    if renderer is not None:
-        renderer.close()
 
     # stage durations from consecutive stamps; "write" collects the time outside figures/HTML
     wall: dict[str, float] = {s: 0.0 for s in STAGES}
@@ -285,7 +265,6 @@ def _profile_child(out_dir: str, per_figure: bool, helpers: bool) -> dict[str, A
         "total cpu": stamps[-1][2] - c0,
         "loaded": loaded,
         "figures": figure_times,
-        "helpers": renderer is not None and renderer.error is None,
         "threads": _blas_threads(),
     }
 
@@ -298,7 +277,7 @@ def _blas_threads() -> str:
     return ", ".join(f"{i['internal_api']} {i['num_threads']}" for i in threadpool_info()) or "-"
 
 
-def profile(runs: int, tmp: Path, per_figure: bool, helpers: bool) -> list[dict[str, Any]]:
+def profile(runs: int, tmp: Path, per_figure: bool) -> list[dict[str, Any]]:
     """The stage profile of ``runs`` fresh processes."""
     out = []
     for r in range(runs):
@@ -306,9 +285,8 @@ def profile(runs: int, tmp: Path, per_figure: bool, helpers: bool) -> list[dict[
             sys.executable,
             __file__,
             "--child",
-            str(tmp / f"profile{r}-{int(helpers)}"),
+            str(tmp / f"profile{r}"),
             *(["--figures"] if per_figure else []),
-            *(["--helpers"] if helpers else []),
         ]
         proc = subprocess.run(argv, capture_output=True, env=child_env(), check=False)
         if proc.returncode != 0:
@@ -329,10 +307,9 @@ def main() -> None:
     ap.add_argument("--profile-runs", type=int, default=3, help="fresh processes profiled")
     ap.add_argument("--figures", action="store_true", help="also time each figure (in-process)")
     ap.add_argument("--child", help=argparse.SUPPRESS)
-    ap.add_argument("--helpers", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.child:
-        print(json.dumps(_profile_child(args.child, args.figures, args.helpers)))
+        print(json.dumps(_profile_child(args.child, args.figures)))
         return
 
     tmp = Path(tempfile.mkdtemp(prefix="bench_cli-"))
@@ -361,33 +338,23 @@ def main() -> None:
         listed = ", ".join(bad) if bad else "none of " + ", ".join(FORBIDDEN)
         print(f"import microg loads {listed}")
 
-        serial = profile(args.profile_runs, tmp, args.figures, helpers=False)
-        helped = profile(args.profile_runs, tmp, False, helpers=True)
+        serial = profile(args.profile_runs, tmp, args.figures)
         print(
-            f"\nmicrog analyze, stage by stage (median of {len(serial)} fresh processes each; "
+            f"\nmicrog analyze, stage by stage (median of {len(serial)} fresh processes; "
             f"BLAS: {serial[0]['threads']})"
         )
-        print(
-            f"  {'stage':<12} {'wall [s]':>9} {'cpu [s]':>8} {'helpers: wall':>14}"
-            "   (first loaded in the stage)"
-        )
+        print(f"  {'stage':<12} {'wall [s]':>9} {'cpu [s]':>8}   (first loaded in the stage)")
         for stage in STAGES:
             libs = sorted({m for r in serial for m in r["loaded"][stage]})
             note = f"   {', '.join(libs)}" if libs else ""
             print(
                 f"  {stage:<12} {_median_of(serial, 'wall', stage):>9.3f} "
-                f"{_median_of(serial, 'cpu', stage):>8.3f} "
-                f"{_median_of(helped, 'wall', stage):>14.3f}{note}"
+                f"{_median_of(serial, 'cpu', stage):>8.3f}{note}"
             )
         print(
             f"  {'total':<12} {_median_of(serial, 'total'):>9.3f} "
-            f"{_median_of(serial, 'total cpu'):>8.3f} {_median_of(helped, 'total'):>14.3f}"
+            f"{_median_of(serial, 'total cpu'):>8.3f}"
             "   (in-process, without the interpreter start)"
-        )
-        used = sum(bool(r["helpers"]) for r in helped)
-        print(
-            f"  helpers: figures drawn by forked helper processes in {used} of {len(helped)} "
-            "runs (their wall time is the caller's wait)"
         )
         if args.figures:
             print("\ndrawing of each figure, in-process (median, s)")
