@@ -7,6 +7,7 @@ import os
 import re
 import shutil
 import subprocess
+import sys
 import tempfile
 from pathlib import Path
 
@@ -196,3 +197,36 @@ def test_limits(tmp_path: Path, capsys, args, needle) -> None:
     rc, _, err = _run(capsys, ["analyze", *FAST, "--out", str(tmp_path / "never"), *args])
     assert rc == 2 and needle in err and err.count("\n") == 1 and "Traceback" not in err
     assert not (tmp_path / "never").exists()
+
+
+LIBRARY_FIGURES = r"""
+import json
+import microg
+from microg.report.analysis import figures
+result = microg.analyze("ioc", observe=["lab"], duration=40, dt=0.02)
+print(json.dumps({k: v.hex() for k, v in figures(result).items()}))
+"""
+
+
+def test_the_process_writes_the_librarys_figures(tmp_path: Path) -> None:
+    # reference: the report's figures drawn by the library in a plain interpreter, byte for
+    # byte (the same numbers drawn by the same matplotlib calls and saved by savefig)
+    lib = subprocess.run(
+        [sys.executable, "-c", LIBRARY_FIGURES],
+        capture_output=True,
+        text=True,
+        check=True,
+        timeout=300,
+    )
+    want = {k: bytes.fromhex(v) for k, v in json.loads(lib.stdout).items()}
+    out = tmp_path / "out"
+    argv = [sys.executable, "-m", "microg", "analyze", "--observe", "lab", *FAST]
+    proc = subprocess.run(
+        [*argv, "--json", "--out", str(out)], capture_output=True, text=True, timeout=300
+    )
+    assert proc.returncode == 0, proc.stderr
+    written = {p.name: p.read_bytes() for p in out.glob("*.png")}
+    assert sorted(written) == sorted(want)
+    for name, png in want.items():
+        assert written[name] == png, name
+    assert json.loads(proc.stdout) == json.loads((out / "results.json").read_text())
