@@ -175,7 +175,6 @@ PUBLIC_NAMES: dict[str, tuple[str, ...]] = {
         "DEFAULT_FUNCTIONS",
         "METHODS",
         "PLANES",
-        "STATION_MODULES",
         "discretize",
     ),
     "microg.structure.fem": (
