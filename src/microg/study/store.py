@@ -30,6 +30,7 @@ from typing import Any
 
 import numpy as np
 
+from microg._io import to_jsonable
 from microg.errors import InputError
 from microg.study.plan import CASE_DIMS, Block, Study
 
@@ -159,7 +160,7 @@ class SweepStore:
             "study_sha256": s.sha256,
             "fingerprint": s.fingerprint,
             "study_text": s.text,
-            "study_json": json.dumps(_jsonable(s.to_dict())),
+            "study_json": json.dumps(to_jsonable(s.to_dict())),
             "requirement": req.name,
             "requirement_source": req.source,
             "duration_s": s.record.duration_s,
@@ -216,7 +217,7 @@ class SweepStore:
         """Keep the modes of a solved variant in the store's attributes."""
         sub = self._group["sweep"]
         bases = dict(sub.attrs.get("bases", {}))
-        bases["/".join(key)] = _jsonable(info)
+        bases["/".join(key)] = to_jsonable(info)
         sub.attrs.update({"bases": bases, "updated_utc": _now()})
 
     def bases(self) -> dict[str, Any]:
@@ -252,9 +253,3 @@ class SweepStore:
         import xarray as xr
 
         return xr.open_zarr(self._store, consolidated=True)
-
-
-def _jsonable(obj: Any) -> Any:
-    from microg._io import to_jsonable
-
-    return to_jsonable(obj)

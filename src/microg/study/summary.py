@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from microg._json import json_number
 from microg.errors import InputError
 from microg.study.plan import CASE_DIMS, Study, default_n_modes
 
@@ -95,7 +96,7 @@ class Summary:
             "heatmap": {
                 "dims": list(self.heatmap_dims),
                 "labels": [list(x) for x in self.heatmap_labels],
-                "margin": [[_num(v) for v in row] for row in self.heatmap],
+                "margin": [[json_number(v) for v in row] for row in self.heatmap],
             },
             "fraction_by": {
                 k: [{"value": lab, "complying_fraction": fr} for lab, fr in v]
@@ -143,14 +144,6 @@ class Summary:
         from microg.plotting.study import heatmap_figure
 
         return heatmap_figure(self)
-
-
-def _num(v: float) -> float | str | None:
-    if np.isnan(v):
-        return None
-    if np.isinf(v):
-        return "inf" if v > 0 else "-inf"
-    return float(v)
 
 
 def _sort_key(row: dict[str, Any]) -> tuple[float, float]:
@@ -329,7 +322,7 @@ def _case_row(result: SweepResult, ds: Any, case: tuple[int, ...]) -> dict[str, 
     return {
         "case": {k: (float(v) if k == "damping" else v) for k, v in labels.items()},
         "index": [int(i) for i in case],
-        "margin": _num(float(point.margin.values)),
+        "margin": json_number(float(point.margin.values)),
         "peak_accel_g": float(point.peak_accel_g.values),
         "rms_accel_g": float(point.rms_accel_g.values),
         "complies": bool(point.complies.values),
