@@ -183,9 +183,10 @@ def band_mean_square(timepts: np.ndarray, accel: np.ndarray, bands: BandTable) -
     periodogram of :func:`~microg.environment.spectrum.periodogram` integrated by
     :func:`band_weights`), computed from only the DFT bins the bands overlap when they are
     few: ``X_k = sum_n x_n e^{-2 pi i k n / N}`` as two matrix products with exact integer
-    phases ``(k n) mod N``.  Many series in a few narrow bands (a run's modal accelerations in a point's worst band) then cost a
-    fraction of a full FFT, above all for record lengths with large prime factors (20,001 =
-    3 x 59 x 113).  Otherwise the whole periodogram is taken.
+    phases ``(k n) mod N``.  Many series in a few narrow bands (a run's modal accelerations
+    in a point's worst band) then cost a fraction of a full FFT, above all for record
+    lengths with large prime factors (20,001 = 3 x 59 x 113).  Otherwise the whole
+    periodogram is taken.
 
     Parameters
     ----------
