@@ -192,8 +192,6 @@ GROUPS: tuple[Group, ...] = (
     ),
 )
 
-_GROUP = {g.key: g for g in GROUPS}
-
 # causes of a difference (the summary groups the errata by them)
 CAUSE_INCONSISTENT = "{cn}'s printed matrix and printed frequencies disagree"
 CAUSE_ONE_ELEMENT = "one element of a printed vector wrong (its other elements agree)"

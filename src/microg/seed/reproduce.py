@@ -21,7 +21,6 @@ from microg.dynamics.dense import solve_dense
 from microg.errors import InputError
 from microg.models.station import Station
 from microg.seed.agreement import (
-    MODEL_BOUND,
     Agreement,
     Comparison,
     build_comparisons,
@@ -51,10 +50,6 @@ __all__ = [
     "report_point_response",
     "reproduce",
 ]
-
-#: relative bound within which a model element counts as matching Appendix C
-MATRIX_BOUND = MODEL_BOUND
-
 
 @dataclass(frozen=True)
 class ReproduceOptions:
