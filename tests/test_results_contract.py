@@ -460,10 +460,11 @@ CONTRACT: dict[str, tuple[str, ...]] = {
 
 #: public dataclasses that are inputs or internal steps, not results (no contract)
 NOT_RESULTS = {
-    "microg.environment.quasisteady.Attitude",
-    "microg.environment.quasisteady.Drag",
-    "microg.environment.quasisteady.AtmosphereInputs",
-    "microg.environment.quasisteady.OrbitInputs",
+    "microg.environment.attitude.Attitude",
+    "microg.environment.drag.Drag",
+    "microg.environment.drag.AtmosphereInputs",
+    "microg.environment.orbit.OrbitInputs",
+    "microg.environment.orbit.OrbitSamples",
     "microg.environment.quasisteady.QuasiSteadyRequirement",
     "microg.environment.sources.BandLevels",
     "microg.environment.sources.Source",

@@ -37,6 +37,7 @@ __all__ = [
     "check_heatmap",
 ]
 
+
 class SweepRecord(Protocol):
     """What a summary reads of a sweep (:class:`microg.study.run.SweepResult` is one).
 
