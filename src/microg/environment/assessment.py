@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from microg._json import json_numbers
-from microg.environment._record import as_axes, check_finite
+from microg.environment._samples import as_axes, check_finite
 from microg.environment.bands import MIN_BINS, MIN_TIME_BANDWIDTH, band_rms
 from microg.environment.integrated import (
     IntegratedAcceleration,

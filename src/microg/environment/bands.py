@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 
 from microg._json import json_by_name, json_numbers
-from microg.environment._record import as_axes, axis_names, sample_rate
+from microg.environment._samples import as_axes, axis_names, sample_rate
 from microg.environment.requirements import BandTable
 from microg.environment.spectrum import Spectrum, periodogram
 from microg.errors import InputError

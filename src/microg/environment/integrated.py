@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from microg._json import json_number, json_numbers
-from microg.environment._record import as_axes, axis_names, sample_rate, xr_dataset
+from microg.environment._samples import as_axes, axis_names, sample_rate, xr_dataset
 from microg.errors import InputError
 
 if TYPE_CHECKING:

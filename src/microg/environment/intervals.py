@@ -31,7 +31,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from microg._json import json_by_name, json_nested, json_numbers
-from microg.environment._record import as_axes, check_finite, sample_rate
+from microg.environment._samples import as_axes, check_finite, sample_rate
 from microg.environment.assessment import MAX_SAMPLES
 from microg.environment.bands import MIN_BINS, MIN_TIME_BANDWIDTH, band_rms
 from microg.environment.requirements import BandTable, Requirement

@@ -40,8 +40,8 @@ them: ``from microg.environment.metrics import assess`` keeps working.
 from __future__ import annotations
 
 from microg._json import json_number
-from microg.environment._record import as_axes as _as_axes  # noqa: F401 - the figures' import
-from microg.environment._record import axis_names
+from microg.environment._samples import as_axes as _as_axes  # noqa: F401 - the figures' import
+from microg.environment._samples import axis_names
 from microg.environment.assessment import MAX_SAMPLES, Assessment, assess
 from microg.environment.bands import (
     MIN_BINS,

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from microg._json import json_by_name, json_numbers
-from microg.environment._record import as_axes, axis_names, sample_rate, xr_dataset
+from microg.environment._samples import as_axes, axis_names, sample_rate, xr_dataset
 from microg.errors import InputError
 from microg.units import G0
 

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from microg._json import json_by_name, json_number, json_numbers
-from microg.environment._record import axis_names, xr_dataset
+from microg.environment._samples import axis_names, xr_dataset
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure

@@ -1,4 +1,4 @@
-"""An acceleration record as the environment stage takes it: rows of axes, uniform times.
+"""The samples of a record as the metrics take them: rows of axes, uniform times.
 
 The checks every record-based quantity shares (spectra, band RMS, integrals, intervals):
 the shape of the samples, the sampling rate of the times, finiteness, the names of the axes,
