@@ -3,14 +3,14 @@
 Layout (zarr format 2, consolidated metadata; ``xarray.open_zarr(DIR/results.zarr)`` reads it
 as one labelled Dataset):
 
-* one dimension per axis of the study (:data:`~microg.study.plan.CASE_DIMS`), plus ``axis``
+* one dimension per axis of the study (:data:`~microg.study.cases.CASE_DIMS`), plus ``axis``
   (x, y, z) and ``band`` (the requirement's 1/3-octave bands below Nyquist, by centre, Hz);
 * variables ``peak_accel_g``, ``rms_accel_g`` (magnitude), ``peak_accel_g_axis``,
   ``rms_accel_g_axis`` (per axis), ``band_rms_g`` (per axis and band), ``margin`` (the worst
   ``limit / band RMS`` over the judged bands and axes), ``complies`` and ``computed`` (the case
   is in the plan and its block is written); band coordinates ``band_lower_hz``,
   ``band_upper_hz``, ``limit_g`` and ``judged`` (the bands the record resolves);
-* one chunk per variable and block (:meth:`~microg.study.plan.Study.block`): a block's values
+* one chunk per variable and block (:meth:`~microg.study.cases.Study.block`): a block's values
   are written whole, by one writer (the process that runs the sweep), ``computed`` last;
 * ``sweep/done`` (a zarr array beside the Dataset, one flag per block id) records the finished
   blocks; a block is marked done only after its values are written, so a sweep that stops
@@ -32,7 +32,7 @@ import numpy as np
 
 from microg._io import to_jsonable
 from microg.errors import InputError
-from microg.study.plan import CASE_DIMS, Block, Study
+from microg.study.cases import CASE_DIMS, Block, Study
 
 __all__ = ["VARIABLES", "STORE_NAME", "SweepStore", "band_table"]
 

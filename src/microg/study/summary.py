@@ -24,7 +24,7 @@ import numpy as np
 
 from microg._json import json_number
 from microg.errors import InputError
-from microg.study.plan import CASE_DIMS, Study, default_n_modes
+from microg.study.cases import CASE_DIMS, Study, default_n_modes
 from microg.study.store import SweepStore
 
 __all__ = [
