@@ -443,10 +443,10 @@ CONTRACT: dict[str, tuple[str, ...]] = {
     "microg.isolation.mount.MountChoice": ("to_dict", "to_xarray", "plot"),
     "microg.isolation.advise.IsolationAdvice": ("to_dict", "to_xarray", "plot"),
     # location
-    "microg.location.amap.AccelerationMap": ("to_dict", "to_xarray", "plot"),
-    "microg.location.amap.LocateResult": ("to_dict", "to_xarray", "plot"),
-    "microg.location.amap.Location": ("to_dict",),
-    "microg.location.amap.SitePeak": ("to_dict",),
+    "microg.location.mapping.AccelerationMap": ("to_dict", "to_xarray", "plot"),
+    "microg.location.pipeline.LocateResult": ("to_dict", "to_xarray", "plot"),
+    "microg.location.mapping.Location": ("to_dict",),
+    "microg.location.site.SitePeak": ("to_dict",),
     "microg.location.layout.LayoutResult": ("to_dict", "to_xarray", "plot"),
     "microg.location.sampling.Node": ("to_dict",),
     # dynamics (frequency.py)
@@ -473,6 +473,7 @@ NOT_RESULTS = {
     "microg.environment.transient.TransientCriteria",
     "microg.location.layout.MovableMass",
     "microg.location.sampling.SampleLine",
+    "microg.location.peaks.PointPeaks",  # the kernel's step; the map and SitePeak are results
     "microg.dynamics.frequency.HarmonicLines",
     "microg.dynamics.frequency.BandForceSpectrum",
     "microg.dynamics.frequency.ForcePSD",
