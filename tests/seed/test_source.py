@@ -1,6 +1,7 @@
 """The seed report's record and the provenance of a reproduction.
 
-References: the OCR'd copy of the report (``tests/data/seed/``), the shipped files read directly from the package directory, and hashlib.
+References: the OCR'd copy of the report (``tests/data/seed/``), the shipped files read
+directly from the package directory, and hashlib.
 """
 
 from __future__ import annotations
@@ -9,8 +10,6 @@ import datetime as dt
 import hashlib
 import re
 from pathlib import Path
-
-import pytest
 
 import microg
 from microg.models.toml import load_station

@@ -1,6 +1,6 @@
 """The errata of the seed report: each printed value beside microg's, and the reason.
 
-Built from the comparisons of a reproduction (:mod:`microg.seed.agreement`) and its recomputed
+Built from the comparisons of a reproduction (:mod:`microg.seed.comparison`) and its recomputed
 tables (:mod:`microg.seed.tables`): one entry per printed value that differs from its
 recomputation by more than its tolerance, with the computed reason (for example a printed
 libration acceleration is called "twice Eq. 3.2" only when it is twice the recomputed value
@@ -13,7 +13,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 
-from microg.seed.agreement import CASE_NAMES, Comparison
+from microg.seed.comparison import CASE_NAMES, Comparison
 from microg.seed.ioc import printed
 from microg.seed.tables import Table4Case
 
