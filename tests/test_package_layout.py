@@ -24,6 +24,7 @@ STAGES: dict[str, int] = {
     "errors": 0,
     "units": 0,
     "_io": 0,
+    "_json": 0,
     "_vectors": 0,
     "_scan": 0,
     "models": 1,

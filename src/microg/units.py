@@ -51,9 +51,6 @@ __all__ = [
     "parse_quantity",
     "parse_unit",
     "check_limit",
-    "to_si",
-    "from_si",
-    "format_quantity",
 ]
 
 #: standard gravity, m/s^2 (used to express accelerations in g)
@@ -664,22 +661,3 @@ def check_limit(value: float, dimension: str, *, where: str) -> float:
             fix="check the value and its unit (limits: docs/model-format.md)",
         )
     return value
-
-
-def to_si(value: float, unit: str) -> float:
-    """Convert ``value`` in ``unit`` to SI base units."""
-    reg = registry()
-    return float(reg.Quantity(value, unit).to_base_units().magnitude)
-
-
-def from_si(value: float, si_unit: str, unit: str) -> float:
-    """Convert ``value`` from ``si_unit`` to ``unit``."""
-    reg = registry()
-    return float(reg.Quantity(value, si_unit).to(unit).magnitude)
-
-
-def format_quantity(value: float, si_unit: str, unit: str | None = None, digits: int = 4) -> str:
-    """Format an SI value for output, optionally converted to ``unit``."""
-    if unit is None:
-        return f"{value:.{digits}g} {si_unit}"
-    return f"{from_si(value, si_unit, unit):.{digits}g} {unit}"

@@ -19,17 +19,17 @@ import numpy as np
 import pytest
 
 from microg.dynamics.crew import CrewPushoff
-from microg.seed.agreement import (
+from microg.seed.agreement import summarize
+from microg.seed.comparison import (
     CAUSE_HALF,
     CAUSE_UNEXPLAINED,
     GROUPS,
     MODEL_BOUND,
-    case_solution,
     rounding_bound,
-    summarize,
 )
 from microg.seed.ioc import FT, LBF, half_unit, printed, printed_literals
 from microg.seed.reproduce import ReproduceOptions, reproduce
+from microg.seed.routes import case_solution
 
 ROOT = Path(__file__).resolve().parents[2]
 

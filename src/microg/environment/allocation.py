@@ -29,6 +29,7 @@ from typing import Any
 
 import numpy as np
 
+from microg._json import finite_list
 from microg._vectors import AXIS_NAMES, parse_direction
 from microg.dynamics.frequency import BandForceSpectrum, Load, band_response, damping_ratios
 from microg.dynamics.modes import Modes
@@ -44,10 +45,6 @@ ALLOCATION_ASSUMPTIONS = (
     "is flat within each requirement band and its power stays in that band; each band is "
     "allocated on its own, to the minimum over the three axes"
 )
-
-
-def _clean(a: Any) -> list[Any]:
-    return [float(v) if np.isfinite(v) else None for v in np.ravel(np.asarray(a, float))]
 
 
 @dataclass(frozen=True)
@@ -103,18 +100,18 @@ class Allocation:
             "at": self.at,
             "direction": [float(v) for v in self.direction],
             "requirement": self.requirement,
-            "center_hz": _clean(self.center_hz),
-            "lower_hz": _clean(self.lower_hz),
-            "upper_hz": _clean(self.upper_hz),
-            "limit_g": _clean(self.limit_g),
-            "allowed_rms_n": _clean(self.allowed_rms_n),
+            "center_hz": finite_list(self.center_hz),
+            "lower_hz": finite_list(self.lower_hz),
+            "upper_hz": finite_list(self.upper_hz),
+            "limit_g": finite_list(self.limit_g),
+            "allowed_rms_n": finite_list(self.allowed_rms_n),
             "governing_axis": list(self.governing_axis),
             "exceeded": [bool(v) for v in self.exceeded],
             "existing_rms_g_axis": {
-                a: _clean(self.existing_rms_g[k]) for k, a in enumerate(AXIS_NAMES)
+                a: finite_list(self.existing_rms_g[k]) for k, a in enumerate(AXIS_NAMES)
             },
             "frf_g2_per_n2_axis": {
-                a: _clean(self.frf_g2_per_n2[k]) for k, a in enumerate(AXIS_NAMES)
+                a: finite_list(self.frf_g2_per_n2[k]) for k, a in enumerate(AXIS_NAMES)
             },
             "assumptions": self.assumptions,
             "warnings": list(self.warnings),

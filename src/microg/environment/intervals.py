@@ -30,20 +30,13 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from microg.environment.metrics import (
-    MAX_SAMPLES,
-    MIN_BINS,
-    MIN_TIME_BANDWIDTH,
-    Spectrum,
-    _as_axes,
-    _check_finite,
-    _sample_rate,
-    acceleration_psd,
-    band_rms,
-    json_number,
-)
+from microg._json import json_by_name, json_nested, json_numbers
+from microg.environment._samples import as_axes, check_finite, sample_rate
+from microg.environment.assessment import MAX_SAMPLES
+from microg.environment.bands import MIN_BINS, MIN_TIME_BANDWIDTH, band_rms
 from microg.environment.requirements import BandTable, Requirement
 from microg.environment.requirements import requirement as requirement_by_name
+from microg.environment.spectrum import Spectrum, acceleration_psd
 from microg.errors import InputError
 from microg.units import G0
 
@@ -68,16 +61,6 @@ __all__ = [
 PIMS_PERCENTILES = (1.0, 25.0, 50.0, 75.0, 99.0)
 #: largest spectrogram kept (values over axes, frequencies and times); longer segments beyond
 MAX_SPECTROGRAM_VALUES = 6_000_000
-
-
-def _nums(a: np.ndarray) -> list[Any]:
-    return [json_number(v) for v in np.ravel(a)]
-
-
-def _per_axis(names: tuple[str, ...], a: np.ndarray) -> dict[str, Any]:
-    """{axis: nested list} over the first dimension of ``a``."""
-    conv = np.vectorize(json_number, otypes=[object])
-    return {n: conv(r).tolist() for n, r in zip(names, a, strict=True)}
 
 
 def percentile_linear(values: np.ndarray, q: tuple[float, ...], axis: int = 0) -> np.ndarray:
@@ -140,11 +123,11 @@ class IntervalBandRMS:
         return {
             "requirement": self.requirement,
             "interval_s": self.interval_s,
-            "t_start_s": _nums(self.t_start_s),
-            "center_hz": _nums(self.bands.center_hz),
-            "lower_hz": _nums(self.bands.lower_hz),
-            "upper_hz": _nums(self.bands.upper_hz),
-            "limit_g": _nums(self.limit_g),
+            "t_start_s": json_numbers(self.t_start_s),
+            "center_hz": json_numbers(self.bands.center_hz),
+            "lower_hz": json_numbers(self.bands.lower_hz),
+            "upper_hz": json_numbers(self.bands.upper_hz),
+            "limit_g": json_numbers(self.limit_g),
             "resolved": [bool(v) for v in self.resolved],
             "unresolved_bands": [
                 {"center_hz": float(c), "reason": r}
@@ -152,12 +135,13 @@ class IntervalBandRMS:
                 if r
             ],
             "percentiles": list(self.percentiles),
-            "percentile_rms_g": _per_axis(
+            "percentile_rms_g": json_by_name(
                 self.rows, np.moveaxis(self.percentile_rms_g, 1, 0)
             ),  # {row: [percentile][band]}
-            "exceed_fraction_axis": _per_axis(self.axes, self.exceed_fraction),
-            "rms_g_axis": _per_axis(self.axes, np.moveaxis(self.rms_g, 1, 0)),  # [interval][band]
-            "rss_rms_g": np.vectorize(json_number, otypes=[object])(self.rss_g).tolist(),
+            "exceed_fraction_axis": json_by_name(self.axes, self.exceed_fraction),
+            # [interval][band] per axis
+            "rms_g_axis": json_by_name(self.axes, np.moveaxis(self.rms_g, 1, 0)),
+            "rss_rms_g": json_nested(self.rss_g),
             "complies_at_percentile": {
                 str(p): self.complies_at(p) for p in self.percentiles if np.any(self.resolved)
             },
@@ -224,11 +208,11 @@ class IntervalStats:
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready (g, s)."""
         return {
-            "t_start_s": _nums(self.t_start_s),
-            "min_g_axis": _per_axis(self.axes, self.min_g.T),
-            "max_g_axis": _per_axis(self.axes, self.max_g.T),
-            "mean_g_axis": _per_axis(self.axes, self.mean_g.T),
-            "rms_g_axis": _per_axis(self.axes, self.rms_g.T),
+            "t_start_s": json_numbers(self.t_start_s),
+            "min_g_axis": json_by_name(self.axes, self.min_g.T),
+            "max_g_axis": json_by_name(self.axes, self.max_g.T),
+            "mean_g_axis": json_by_name(self.axes, self.mean_g.T),
+            "rms_g_axis": json_by_name(self.axes, self.rms_g.T),
         }
 
     def to_xarray(self) -> Any:
@@ -285,9 +269,9 @@ class BandLimitedRMS:
         return {
             "band_hz": list(self.band_hz),
             "interval_s": self.interval_s,
-            "t_start_s": _nums(self.t_start_s),
-            "rms_g_axis": _per_axis(self.axes, self.rms_g.T),
-            "rss_g": _nums(self.rss_g),
+            "t_start_s": json_numbers(self.t_start_s),
+            "rms_g_axis": json_by_name(self.axes, self.rms_g.T),
+            "rss_g": json_numbers(self.rss_g),
         }
 
     def to_xarray(self) -> Any:
@@ -402,9 +386,9 @@ class CumulativeRMS:
         f = self.freq_hz if at_hz is None else np.asarray(at_hz, float)
         r = self.rms_g if at_hz is None else self.at(f)
         return {
-            "freq_hz": _nums(f),
-            "rms_g_axis": _per_axis(self.axes, r),
-            "rss_g": _nums(np.sqrt(np.sum(r**2, axis=0))),
+            "freq_hz": json_numbers(f),
+            "rms_g_axis": json_by_name(self.axes, r),
+            "rss_g": json_numbers(np.sqrt(np.sum(r**2, axis=0))),
         }
 
     def to_xarray(self) -> Any:
@@ -594,9 +578,9 @@ def interval_band_rms(
     axes : names of the rows of ``accel``
     percentiles : percentiles over intervals, 0-100
     """
-    a = _as_axes(accel)
+    a = as_axes(accel)
     t = np.asarray(timepts, dtype=float)
-    fs = _sample_rate(t)
+    fs = sample_rate(t)
     per = int(round(interval_s * fs))
     ni = a.shape[1] // per if per >= 8 else 0
     if ni == 0:
@@ -647,7 +631,7 @@ def interval_products(
     cutoff_hz : the data's anti-alias cutoff, Hz (bands above it are not judged)
     sample_rate_hz : exact sampling rate, Hz, when known (else from ``timepts``)
     """
-    a = _as_axes(accel)
+    a = as_axes(accel)
     t = np.asarray(timepts, dtype=float)
     if a.shape[1] != t.size:
         raise InputError(f"timepts has {t.size} samples, accel {a.shape[1]}", where="accel")
@@ -657,13 +641,13 @@ def interval_products(
             where="accel",
             fix="split the record",
         )
-    _check_finite(a)
+    check_finite(a)
     axes = (
         tuple(axes)[: a.shape[0]]
         if len(axes) >= a.shape[0]
         else tuple(f"axis{i}" for i in range(a.shape[0]))
     )
-    fs = float(sample_rate_hz) if sample_rate_hz is not None else _sample_rate(t)
+    fs = float(sample_rate_hz) if sample_rate_hz is not None else sample_rate(t)
     dt = 1.0 / fs
     if not (np.isfinite(interval_s) and interval_s > 0):
         raise InputError(f"interval {interval_s!r} s is not positive", where="interval_s")

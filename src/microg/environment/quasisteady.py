@@ -53,6 +53,13 @@ Compliance is judged against the ISS quasi-steady requirement, 1 micro-g at inte
 locations (NASA-CR-205357; ``microg/data/quasi_steady_requirement.toml``), on the peak
 magnitude over the orbit.  Without a drag input (ballistic coefficient, or area and C_d) the
 verdict is withheld (``complies`` None) and a warning says so.
+
+Modules, one concept each: :mod:`~microg.environment.gravity_gradient` (the tidal term),
+:mod:`~microg.environment.attitude` (attitudes and the rotation term),
+:mod:`~microg.environment.orbit` (the orbit, its samples, geodesy),
+:mod:`~microg.environment.drag` (the atmosphere and the drag term); this module assembles
+them at the named points and over the structure (:func:`quasi_steady`, its result, the
+requirement) and keeps their names importable from here.
 """
 
 from __future__ import annotations
@@ -60,13 +67,38 @@ from __future__ import annotations
 import math
 import tomllib
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from functools import lru_cache
 from importlib import resources
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from microg.environment.attitude import ATTITUDES, LVLH_FROM_STATION, Attitude, rotation_accel
+from microg.environment.drag import (
+    AP_DEFAULT,
+    ATMOSPHERES,
+    CD_DEFAULT,
+    DATE_DEFAULT,
+    EXPONENTIAL_ATMOSPHERE,
+    F107_DEFAULT,
+    AtmosphereInputs,
+    Drag,
+    density,
+    drag_accel,
+    exponential_density,
+)
+from microg.environment.gravity_gradient import gravity_gradient_accel
+from microg.environment.orbit import (
+    EARTH_EQUATORIAL_RADIUS_M,
+    EARTH_FLATTENING,
+    EARTH_ROTATION_RAD_S,
+    MAX_SAMPLES,
+    OrbitInputs,
+    OrbitSamples,
+    geodetic,
+    orbit_samples,
+)
 from microg.errors import InputError
 from microg.units import G0, parse_quantity
 
@@ -81,12 +113,16 @@ __all__ = [
     "CD_DEFAULT",
     "DATE_DEFAULT",
     "Drag",
+    "ATMOSPHERES",
     "EARTH_EQUATORIAL_RADIUS_M",
+    "EARTH_FLATTENING",
     "EARTH_ROTATION_RAD_S",
     "EXPONENTIAL_ATMOSPHERE",
     "F107_DEFAULT",
     "LVLH_FROM_STATION",
+    "MAX_SAMPLES",
     "OrbitInputs",
+    "OrbitSamples",
     "PointQuasiSteady",
     "QuasiSteadyMap",
     "QuasiSteadyRequirement",
@@ -95,477 +131,12 @@ __all__ = [
     "exponential_density",
     "geodetic",
     "gravity_gradient_accel",
-    "gravity_gradient_linear",
     "orbit_samples",
     "peak_magnitude",
     "quasi_steady",
     "quasi_steady_requirement",
     "rotation_accel",
 ]
-
-#: WGS84 equatorial radius, m, and flattening
-EARTH_EQUATORIAL_RADIUS_M = 6378137.0
-EARTH_FLATTENING = 1.0 / 298.257223563
-#: Earth rotation rate, rad/s (IERS, the rate of the Earth rotation angle)
-EARTH_ROTATION_RAD_S = 7.292115146706979e-5
-#: lowest and highest orbit altitudes accepted, m (below 100 km there is no orbit)
-MIN_ALTITUDE_M = 100e3
-MAX_RADIUS_M = 1e8
-#: station frame -> LVLH in LVLH hold (x velocity, y orbit normal, z zenith -> X, -Y, -Z)
-LVLH_FROM_STATION = np.diag([1.0, -1.0, -1.0])
-#: drag coefficient used with an area when none is given (free-molecular flow, Vallado 2013)
-CD_DEFAULT = 2.2
-#: solar and geomagnetic inputs used when none are given: moderate activity (assumed)
-F107_DEFAULT = 150.0
-AP_DEFAULT = 15.0
-#: date used when none is given (UTC, an equinox)
-DATE_DEFAULT = "2024-03-20T12:00:00"
-ATTITUDES = ("lvlh", "inertial", "rate")
-ATMOSPHERES = ("msis", "exponential")
-#: largest number of orbit samples
-MAX_SAMPLES = 100_000
-#: points per vectorised block of the map (bounds the (points, samples) scratch memory)
-_MAP_BLOCK = 8192
-
-#: exponential atmosphere, Vallado (2013) Fundamentals of Astrodynamics and Applications, 4th
-#: ed., Table 8-4: base altitude km, nominal density kg/m^3, scale height km (CIRA-72 based)
-EXPONENTIAL_ATMOSPHERE = np.array(
-    [
-        (0, 1.225, 7.249),
-        (25, 3.899e-2, 6.349),
-        (30, 1.774e-2, 6.682),
-        (40, 3.972e-3, 7.554),
-        (50, 1.057e-3, 8.382),
-        (60, 3.206e-4, 7.714),
-        (70, 8.770e-5, 6.549),
-        (80, 1.905e-5, 5.799),
-        (90, 3.396e-6, 5.382),
-        (100, 5.297e-7, 5.877),
-        (110, 9.661e-8, 7.263),
-        (120, 2.438e-8, 9.473),
-        (130, 8.484e-9, 12.636),
-        (140, 3.845e-9, 16.149),
-        (150, 2.070e-9, 22.523),
-        (180, 5.464e-10, 29.740),
-        (200, 2.789e-10, 37.105),
-        (250, 7.248e-11, 45.546),
-        (300, 2.418e-11, 53.628),
-        (350, 9.518e-12, 53.298),
-        (400, 3.725e-12, 58.515),
-        (450, 1.585e-12, 60.828),
-        (500, 6.967e-13, 63.822),
-        (600, 1.454e-13, 71.835),
-        (700, 3.614e-14, 88.667),
-        (800, 1.170e-14, 124.64),
-        (900, 5.245e-15, 181.05),
-        (1000, 3.019e-15, 268.00),
-    ]
-)
-
-
-# ------------------------------------------------------------------------------- kernels
-
-
-def gravity_gradient_accel(rho_m: np.ndarray, r_cm_m: np.ndarray, mu: float) -> np.ndarray:
-    """Tidal specific force ``g(R) - g(R + rho)`` at offsets ``rho`` from the CM, m/s^2.
-
-    The full two-body difference (no linearisation), written without cancellation: with
-    ``s = R + rho``, ``g(R) - g(s) = mu [rho / S^3 + R (1/S^3 - 1/R^3)]`` and
-    ``1/S^3 - 1/R^3 = (R - S)(R^2 + R S + S^2) / (R^3 S^3)``,
-    ``R - S = -(2 R . rho + rho . rho) / (R + S)``.
-
-    Parameters
-    ----------
-    rho_m : (..., 3) offsets of the points from the centre of mass, m
-    r_cm_m : (..., 3) position of the centre of mass from the Earth's centre, m (broadcasts)
-    mu : gravitational parameter, m^3/s^2
-
-    Returns
-    -------
-    (..., 3) m/s^2, in the frame of the inputs.
-    """
-    rho = np.asarray(rho_m, dtype=float)
-    rc = np.asarray(r_cm_m, dtype=float)
-    s = rc + rho
-    R2 = np.einsum("...i,...i->...", rc, rc)[..., None]
-    S2 = np.einsum("...i,...i->...", s, s)[..., None]
-    R, S = np.sqrt(R2), np.sqrt(S2)
-    two_r_rho = 2.0 * np.einsum("...i,...i->...", rho, rc)[..., None]
-    r_minus_s = -(two_r_rho + np.einsum("...i,...i->...", rho, rho)[..., None]) / (R + S)
-    S3 = S2 * S
-    inv_diff = r_minus_s * (R2 + R * S + S2) / (R2 * R * S3)
-    return mu * (rho / S3 + rc * inv_diff)
-
-
-def gravity_gradient_linear(rho_m: np.ndarray, r_hat: np.ndarray, mean_motion: float) -> np.ndarray:
-    """First-order tidal specific force ``-n^2 (3 r_hat (r_hat . rho) - rho)``, m/s^2.
-
-    Parameters
-    ----------
-    rho_m : (..., 3) offsets from the centre of mass, m
-    r_hat : (..., 3) unit vector from the Earth's centre to the CM (broadcasts)
-    mean_motion : ``n = sqrt(mu / R^3)``, rad/s
-    """
-    rho = np.asarray(rho_m, dtype=float)
-    rh = np.asarray(r_hat, dtype=float)
-    return -(mean_motion**2) * (3.0 * rh * np.sum(rh * rho, axis=-1)[..., None] - rho)
-
-
-def rotation_accel(
-    rho_m: np.ndarray, omega_rad_s: np.ndarray, alpha_rad_per_s2: np.ndarray | None = None
-) -> np.ndarray:
-    """Acceleration of a point fixed in a rotating body: ``alpha x rho + omega x (omega x rho)``.
-
-    Parameters
-    ----------
-    rho_m : (..., 3) offsets from the centre of mass, m
-    omega_rad_s : (3,) inertial angular velocity of the body, rad/s (same frame)
-    alpha_rad_per_s2 : (3,) angular acceleration, rad/s^2 (zero by default)
-
-    Returns
-    -------
-    (..., 3) m/s^2 (centripetal: toward the rotation axis).
-    """
-    rho = np.asarray(rho_m, dtype=float)
-    w = np.asarray(omega_rad_s, dtype=float)
-    # omega x (omega x rho) = (omega omega^T - |omega|^2 I) rho; alpha x rho = [alpha]x rho
-    m = np.outer(w, w) - float(w @ w) * np.eye(3)
-    if alpha_rad_per_s2 is not None:
-        a = np.asarray(alpha_rad_per_s2, dtype=float)
-        m = m + np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
-    return rho @ m.T
-
-
-def drag_accel(
-    density_kg_per_m3: np.ndarray, v_rel_mps: np.ndarray, ballistic_coefficient_kg_per_m2: float
-) -> np.ndarray:
-    """Drag specific force ``-(1/2) rho |v| v / B``, m/s^2 (against the relative wind).
-
-    Parameters
-    ----------
-    density_kg_per_m3 : (...,) atmospheric density, kg/m^3
-    v_rel_mps : (..., 3) velocity relative to the atmosphere, m/s
-    ballistic_coefficient_kg_per_m2 : ``B = m / (C_d A)``, kg/m^2
-    """
-    v = np.asarray(v_rel_mps, dtype=float)
-    speed = np.sqrt(np.sum(v * v, axis=-1))
-    rho = np.asarray(density_kg_per_m3, dtype=float)
-    return -(0.5 * rho * speed / ballistic_coefficient_kg_per_m2)[..., None] * v
-
-
-def exponential_density(altitude_m: np.ndarray) -> np.ndarray:
-    """Density of the exponential atmosphere (Vallado 2013, Table 8-4), kg/m^3.
-
-    ``rho = rho_0 exp(-(h - h_0) / H)`` with the band of the table holding ``h``.
-
-    Parameters
-    ----------
-    altitude_m : altitude above the ellipsoid, m (>= 0)
-    """
-    h_km = np.asarray(altitude_m, dtype=float) / 1e3
-    tab = EXPONENTIAL_ATMOSPHERE
-    i = np.clip(np.searchsorted(tab[:, 0], h_km, side="right") - 1, 0, tab.shape[0] - 1)
-    return tab[i, 1] * np.exp(-(h_km - tab[i, 0]) / tab[i, 2])
-
-
-def geodetic(r_ecef_m: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """WGS84 geodetic latitude and longitude (degrees) and altitude (m) of ECEF positions.
-
-    Bowring's formula with two refinements (sub-millimetre at orbital altitudes).
-
-    Parameters
-    ----------
-    r_ecef_m : (..., 3) Earth-fixed positions, m
-    """
-    r = np.asarray(r_ecef_m, dtype=float)
-    x, y, z = r[..., 0], r[..., 1], r[..., 2]
-    a = EARTH_EQUATORIAL_RADIUS_M
-    f = EARTH_FLATTENING
-    b = a * (1.0 - f)
-    e2 = f * (2.0 - f)
-    ep2 = e2 / (1.0 - e2)
-    p = np.hypot(x, y)
-    lat = np.arctan2(z, p * (1.0 - e2))
-    for _ in range(3):
-        beta = np.arctan2((1.0 - f) * np.sin(lat), np.cos(lat))
-        lat = np.arctan2(z + ep2 * b * np.sin(beta) ** 3, p - e2 * a * np.cos(beta) ** 3)
-    sin_lat = np.sin(lat)
-    n_rad = a / np.sqrt(1.0 - e2 * sin_lat * sin_lat)
-    cos_lat = np.cos(lat)
-    # altitude along the normal, well conditioned at every latitude
-    alt = p * cos_lat + z * sin_lat - n_rad * (1.0 - e2 * sin_lat * sin_lat)
-    return np.degrees(lat), np.degrees(np.arctan2(y, x)), alt
-
-
-def _rodrigues(axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
-    """Rotation matrices (n, 3, 3) about the unit ``axis`` by ``angle`` (n,), rad."""
-    k = np.asarray(axis, float)
-    K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
-    a = np.asarray(angle, float)[:, None, None]
-    return np.eye(3) + np.sin(a) * K + (1.0 - np.cos(a)) * (K @ K)
-
-
-# ------------------------------------------------------------------------------- inputs
-
-
-def _finite(value: float, where: str, *, positive: bool = False, nonneg: bool = False) -> float:
-    v = float(value)
-    if not math.isfinite(v):
-        raise InputError(f"must be a finite number, got {value!r}", where=where)
-    if positive and not v > 0:
-        raise InputError(f"must be > 0, got {value!r}", where=where)
-    if nonneg and v < 0:
-        raise InputError(f"must be >= 0, got {value!r}", where=where)
-    return v
-
-
-def _vector3(value: Any, where: str) -> np.ndarray:
-    v = np.asarray(value, dtype=float)
-    if v.shape != (3,) or not np.all(np.isfinite(v)):
-        raise InputError(f"must be three finite numbers, got {value!r}", where=where)
-    return v
-
-
-@dataclass(frozen=True)
-class Attitude:
-    """The station's attitude for the quasi-steady environment.
-
-    Attributes
-    ----------
-    kind : ``"lvlh"`` (LVLH hold, default), ``"inertial"`` (fixed in inertial space) or
-        ``"rate"`` (a constant body rate ``omega_rad_s``)
-    omega_rad_s : (3,) body rate in the station frame, rad/s (``"rate"`` only)
-    alpha_rad_per_s2 : (3,) angular acceleration in the station frame, rad/s^2 (``"rate"``
-        only; enters the ``alpha x rho`` term, not the attitude history)
-    lvlh_from_station : (3, 3) rotation from station to LVLH axes in LVLH hold (and at the
-        first sample for the other kinds); default :data:`LVLH_FROM_STATION`
-    """
-
-    kind: str = "lvlh"
-    omega_rad_s: np.ndarray | Sequence[float] | None = None
-    alpha_rad_per_s2: np.ndarray | Sequence[float] | None = None
-    lvlh_from_station: np.ndarray = field(default_factory=lambda: LVLH_FROM_STATION.copy())
-
-    def __post_init__(self) -> None:
-        if self.kind not in ATTITUDES:
-            raise InputError(
-                f"unknown attitude {self.kind!r}",
-                where="attitude",
-                fix="use lvlh, inertial or rate",
-            )
-        if self.kind == "rate":
-            if self.omega_rad_s is None:
-                raise InputError("a rate attitude needs the body rate", where="omega")
-            object.__setattr__(self, "omega_rad_s", _vector3(self.omega_rad_s, "omega"))
-            if self.alpha_rad_per_s2 is not None:
-                alpha = _vector3(self.alpha_rad_per_s2, "alpha")
-                object.__setattr__(self, "alpha_rad_per_s2", alpha)
-        elif self.omega_rad_s is not None or self.alpha_rad_per_s2 is not None:
-            raise InputError(
-                f"a rate is given only with attitude 'rate', not {self.kind!r}",
-                where="omega",
-                fix="choose attitude 'rate' or leave the rate out",
-            )
-        m = np.asarray(self.lvlh_from_station, dtype=float)
-        if (
-            m.shape != (3, 3)
-            or not np.allclose(m @ m.T, np.eye(3), atol=1e-12)
-            or np.linalg.det(m) < 0
-        ):
-            raise InputError("must be a proper rotation matrix", where="lvlh_from_station")
-        object.__setattr__(self, "lvlh_from_station", m)
-
-    def to_dict(self, mean_motion: float) -> dict[str, Any]:
-        """JSON-ready echo, with the body rate actually used (rad/s, station frame)."""
-        w, a = self.rates(mean_motion)
-        return {
-            "kind": self.kind,
-            "omega_rad_s": w.tolist(),
-            "alpha_rad_per_s2": a.tolist(),
-            "lvlh_from_station": self.lvlh_from_station.tolist(),
-        }
-
-    def axes(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Velocity, orbit-normal and zenith unit vectors in the station frame at the start."""
-        m = self.lvlh_from_station  # rows: LVLH axes in station coordinates
-        return m[0], -m[1], -m[2]
-
-    def rates(self, mean_motion: float) -> tuple[np.ndarray, np.ndarray]:
-        """Body rate and angular acceleration in the station frame, rad/s and rad/s^2."""
-        if self.kind == "lvlh":
-            return mean_motion * self.axes()[1], np.zeros(3)
-        if self.kind == "inertial":
-            return np.zeros(3), np.zeros(3)
-        assert self.omega_rad_s is not None
-        alpha = np.zeros(3) if self.alpha_rad_per_s2 is None else self.alpha_rad_per_s2
-        return np.asarray(self.omega_rad_s, float), np.asarray(alpha, float)
-
-
-@dataclass(frozen=True)
-class Drag:
-    """Drag inputs: a ballistic coefficient, or an area with a drag coefficient.
-
-    Attributes
-    ----------
-    ballistic_coefficient_kg_per_m2 : ``B = m / (C_d A)``, kg/m^2
-    area_m2 : reference (projected) area, m^2 (instead of ``B``)
-    cd : drag coefficient (with ``area_m2``; default :data:`CD_DEFAULT`)
-    mass_kg : station mass for ``B`` from the area, kg (default: the model's mass)
-    """
-
-    ballistic_coefficient_kg_per_m2: float | None = None
-    area_m2: float | None = None
-    cd: float | None = None
-    mass_kg: float | None = None
-
-    def __post_init__(self) -> None:
-        if self.ballistic_coefficient_kg_per_m2 is not None:
-            _finite(self.ballistic_coefficient_kg_per_m2, "ballistic_coefficient", positive=True)
-            if self.area_m2 is not None or self.cd is not None:
-                raise InputError(
-                    "give a ballistic coefficient, or an area and Cd, not both",
-                    where="ballistic_coefficient",
-                )
-        if self.area_m2 is not None:
-            _finite(self.area_m2, "area", positive=True)
-        if self.cd is not None:
-            _finite(self.cd, "cd", positive=True)
-            if self.area_m2 is None:
-                raise InputError("a drag coefficient needs an area", where="cd", fix="give area")
-        if self.mass_kg is not None:
-            _finite(self.mass_kg, "mass", positive=True)
-
-    @property
-    def given(self) -> bool:
-        """True when there is a drag input."""
-        return self.ballistic_coefficient_kg_per_m2 is not None or self.area_m2 is not None
-
-    def beta(self, model_mass_kg: float) -> float | None:
-        """Ballistic coefficient, kg/m^2 (None without a drag input)."""
-        if self.ballistic_coefficient_kg_per_m2 is not None:
-            return float(self.ballistic_coefficient_kg_per_m2)
-        if self.area_m2 is None:
-            return None
-        mass = self.mass_kg if self.mass_kg is not None else model_mass_kg
-        return float(mass / ((self.cd if self.cd is not None else CD_DEFAULT) * self.area_m2))
-
-    def to_dict(self, model_mass_kg: float) -> dict[str, Any]:
-        """JSON-ready echo."""
-        return {
-            "given": self.given,
-            "ballistic_coefficient_kg_per_m2": self.beta(model_mass_kg),
-            "area_m2": self.area_m2,
-            "cd": (self.cd if self.cd is not None else CD_DEFAULT) if self.area_m2 else None,
-            "mass_kg": (self.mass_kg or model_mass_kg) if self.area_m2 else None,
-        }
-
-
-@dataclass(frozen=True)
-class AtmosphereInputs:
-    """Atmosphere model and its inputs.
-
-    Attributes
-    ----------
-    model : ``"msis"`` (NRLMSIS 2.1 through pymsis; the exponential model if pymsis is
-        missing) or ``"exponential"`` (Vallado 2013 Table 8-4)
-    date_utc : ISO date and time of the first orbit sample, UTC
-    f107_sfu : daily F10.7 solar radio flux of the previous day, solar flux units (1e-22 W/m^2/Hz)
-    f107a_sfu : its 81-day centred mean, sfu
-    ap : daily geomagnetic Ap index
-    defaulted : names of the inputs left at their defaults (reported)
-    """
-
-    model: str = "msis"
-    date_utc: str = DATE_DEFAULT
-    f107_sfu: float = F107_DEFAULT
-    f107a_sfu: float = F107_DEFAULT
-    ap: float = AP_DEFAULT
-    defaulted: tuple[str, ...] = ()
-
-    def __post_init__(self) -> None:
-        if self.model not in ATMOSPHERES:
-            raise InputError(
-                f"unknown atmosphere model {self.model!r}",
-                where="atmosphere",
-                fix="use msis or exponential",
-            )
-        _finite(self.f107_sfu, "f107", positive=True)
-        _finite(self.f107a_sfu, "f107a", positive=True)
-        _finite(self.ap, "ap", nonneg=True)
-        for name, v, hi in (("f107", self.f107_sfu, 1000.0), ("f107a", self.f107a_sfu, 1000.0)):
-            if v > hi:
-                raise InputError(f"must be <= {hi:g} sfu, got {v:g}", where=name)
-        if self.ap > 400:
-            raise InputError(f"must be <= 400, got {self.ap:g}", where="ap")
-        self.date64()
-
-    def date64(self) -> np.datetime64:
-        """The date as numpy datetime64 (ms); an unreadable date is an InputError."""
-        try:
-            d = np.datetime64(str(self.date_utc).replace("Z", ""), "ms")
-        except ValueError:
-            raise InputError(
-                f"not an ISO date and time: {self.date_utc!r}",
-                where="date",
-                fix="write e.g. 2024-03-20T12:00:00",
-            ) from None
-        year = d.astype("datetime64[Y]").astype(int) + 1970
-        if not 1961 <= year <= 2100:
-            raise InputError(f"year {year} is outside 1961-2100", where="date")
-        return d
-
-
-@dataclass(frozen=True)
-class OrbitInputs:
-    """A circular orbit.
-
-    Attributes
-    ----------
-    radius_m : orbit radius, m (Earth centre to the CM)
-    mu_m3_per_s2 : gravitational parameter, m^3/s^2
-    inclination_deg : inclination, degrees (ISS: 51.6)
-    raan_deg : right ascension of the ascending node, degrees
-    arg_latitude_deg : argument of latitude at the first sample, degrees
-    n_samples : samples over one orbit period
-    """
-
-    radius_m: float
-    mu_m3_per_s2: float = 3.986004418e14
-    inclination_deg: float = 51.6
-    raan_deg: float = 0.0
-    arg_latitude_deg: float = 0.0
-    n_samples: int = 180
-
-    def __post_init__(self) -> None:
-        r = _finite(self.radius_m, "radius", positive=True)
-        if r < EARTH_EQUATORIAL_RADIUS_M + MIN_ALTITUDE_M:
-            raise InputError(
-                f"{r:.6g} m is inside the Earth or below {MIN_ALTITUDE_M / 1e3:g} km altitude "
-                f"(the equatorial radius is {EARTH_EQUATORIAL_RADIUS_M:.0f} m)",
-                where="radius",
-                fix="give the orbit radius from the Earth's centre, e.g. 6778 km",
-            )
-        if r > MAX_RADIUS_M:
-            raise InputError(f"must be <= {MAX_RADIUS_M:g} m, got {r:.6g} m", where="radius")
-        _finite(self.mu_m3_per_s2, "mu", positive=True)
-        inc = _finite(self.inclination_deg, "inclination")
-        if not 0.0 <= inc <= 180.0:
-            raise InputError(f"must be in [0, 180] degrees, got {inc:g}", where="inclination")
-        _finite(self.raan_deg, "raan")
-        _finite(self.arg_latitude_deg, "arg_latitude")
-        n = self.n_samples
-        if not (isinstance(n, int | np.integer) and 4 <= n <= MAX_SAMPLES):
-            raise InputError(f"must be an integer in 4..{MAX_SAMPLES}, got {n!r}", where="samples")
-
-    @property
-    def mean_motion_rad_s(self) -> float:
-        """``n = sqrt(mu / R^3)``, rad/s."""
-        return math.sqrt(self.mu_m3_per_s2 / self.radius_m**3)
-
-    @property
-    def period_s(self) -> float:
-        """Orbit period, s."""
-        return 2.0 * math.pi / self.mean_motion_rad_s
 
 
 @dataclass(frozen=True)
@@ -610,140 +181,6 @@ def quasi_steady_requirement() -> QuasiSteadyRequirement:
         source=req["source"],
         verified=bool(req["verified"]),
     )
-
-
-# ------------------------------------------------------------------------------- the orbit
-
-
-@dataclass(frozen=True)
-class OrbitSamples:
-    """One orbit sampled uniformly in time, in the station (body) frame.
-
-    Attributes
-    ----------
-    time_s : (S,) time from the first sample, s
-    r_hat : (S, 3) unit vector Earth centre -> CM, station frame
-    v_rel_mps : (S, 3) velocity relative to the co-rotating atmosphere, station frame, m/s
-    lvlh_from_station : (S, 3, 3) station -> LVLH components at each sample
-    latitude_deg, longitude_deg, altitude_m : (S,) geodetic position of the CM (WGS84)
-    date : (S,) datetime64 of each sample (UTC)
-    """
-
-    time_s: np.ndarray
-    r_hat: np.ndarray
-    v_rel_mps: np.ndarray
-    lvlh_from_station: np.ndarray
-    latitude_deg: np.ndarray
-    longitude_deg: np.ndarray
-    altitude_m: np.ndarray
-    date: np.ndarray
-
-
-def _earth_rotation_angle(date: np.ndarray) -> np.ndarray:
-    """Earth rotation angle (IERS 2003), rad, of datetime64 values (UTC taken as UT1)."""
-    j2000 = np.datetime64("2000-01-01T12:00:00", "ms")
-    days = (date - j2000).astype("timedelta64[ms]").astype(float) / 86_400_000.0
-    frac = (0.7790572732640 + 1.00273781191135448 * days) % 1.0
-    return 2.0 * np.pi * frac
-
-
-def orbit_samples(orbit: OrbitInputs, attitude: Attitude, date: np.datetime64) -> OrbitSamples:
-    """Geometry of one orbit in the station frame: radius and relative-wind directions.
-
-    The inertial reference frame is the station frame at the first sample, where the body is
-    aligned with LVLH (``attitude.lvlh_from_station``).  The CM moves on the circle
-    ``r_hat(theta) = cos(theta) r_hat_0 + sin(theta) v_hat_0``, theta = n t; the body turns by
-    the constant body rate about a fixed axis (Rodrigues), so a vector's station components are
-    ``C(t)^T`` times its inertial ones.  For drag, the orbit in the Earth-centred inertial
-    frame (inclination, node, argument of latitude) gives the geodetic position (for density)
-    and the co-rotating atmosphere's wind: ``v_rel = (v - w_E R cos i) v_hat +
-    w_E R cos(u) sin(i) h_hat``.
-
-    Parameters
-    ----------
-    orbit : OrbitInputs
-    attitude : Attitude
-    date : datetime64 of the first sample (UTC)
-    """
-    n = orbit.mean_motion_rad_s
-    S = int(orbit.n_samples)
-    t = np.arange(S) * (orbit.period_s / S)
-    theta = n * t
-    v0, h0, r0 = attitude.axes()
-    r_in = np.cos(theta)[:, None] * r0 + np.sin(theta)[:, None] * v0
-    v_in = np.cos(theta)[:, None] * v0 - np.sin(theta)[:, None] * r0
-    h_in = np.broadcast_to(h0, r_in.shape)
-    w_body, _ = attitude.rates(n)
-    rate = float(np.linalg.norm(w_body))
-    if rate > 0:
-        C = _rodrigues(w_body / rate, rate * t)  # body -> inertial
-        Ct = np.swapaxes(C, 1, 2)
-        r_b = np.einsum("sij,sj->si", Ct, r_in)
-        v_b = np.einsum("sij,sj->si", Ct, v_in)
-        h_b = np.einsum("sij,sj->si", Ct, h_in)
-    else:
-        r_b, v_b, h_b = r_in, v_in, np.array(h_in)
-    # Earth-centred inertial position for density and co-rotation
-    inc = math.radians(orbit.inclination_deg)
-    raan = math.radians(orbit.raan_deg)
-    u = math.radians(orbit.arg_latitude_deg) + theta
-    R = orbit.radius_m
-    eci = R * np.column_stack(
-        [
-            math.cos(raan) * np.cos(u) - math.sin(raan) * np.sin(u) * math.cos(inc),
-            math.sin(raan) * np.cos(u) + math.cos(raan) * np.sin(u) * math.cos(inc),
-            np.sin(u) * math.sin(inc),
-        ]
-    )
-    dates = date + (t * 1000.0).astype("timedelta64[ms]")
-    era = _earth_rotation_angle(dates)
-    ecef = np.column_stack(
-        [
-            np.cos(era) * eci[:, 0] + np.sin(era) * eci[:, 1],
-            -np.sin(era) * eci[:, 0] + np.cos(era) * eci[:, 1],
-            eci[:, 2],
-        ]
-    )
-    lat, lon, alt = geodetic(ecef)
-    speed = math.sqrt(orbit.mu_m3_per_s2 / R)
-    wr = EARTH_ROTATION_RAD_S * R
-    along = speed - wr * math.cos(inc)
-    cross = wr * np.cos(u) * math.sin(inc)
-    v_rel = along * v_b + cross[:, None] * h_b
-    lvlh = np.stack([v_b, -h_b, -r_b], axis=1)  # rows: LVLH axes in station components
-    return OrbitSamples(t, r_b, v_rel, lvlh, lat, lon, alt, dates)
-
-
-def _density(samples: OrbitSamples, atm: AtmosphereInputs) -> tuple[np.ndarray, str, str | None]:
-    """Density at the samples, the model used and why the fallback was taken (or None)."""
-    reason = None
-    if atm.model == "msis":
-        try:
-            from pymsis import msis
-        except ImportError:
-            reason = "pymsis is not installed (pip install 'microg[atmosphere]')"
-        else:
-            S = samples.time_s.size
-            try:
-                out = msis.calculate(
-                    samples.date.astype("datetime64[s]"),
-                    samples.longitude_deg,
-                    samples.latitude_deg,
-                    samples.altitude_m / 1e3,
-                    f107s=np.full(S, atm.f107_sfu),
-                    f107as=np.full(S, atm.f107a_sfu),
-                    aps=np.full((S, 7), atm.ap),
-                    version=2.1,
-                )
-            except Exception as exc:  # noqa: BLE001 - any pymsis failure falls back, with reason
-                reason = f"pymsis failed ({type(exc).__name__}: {exc})"
-            else:
-                rho = np.asarray(out, float).reshape(S, -1)[:, 0]
-                if np.all(np.isfinite(rho)) and np.all(rho >= 0):
-                    return rho, "NRLMSIS 2.1 (pymsis)", None
-                reason = "pymsis returned non-finite densities"
-    rho = exponential_density(samples.altitude_m)
-    return rho, "exponential (Vallado 2013, Table 8-4; no solar-activity dependence)", reason
 
 
 # ------------------------------------------------------------------------------- results
@@ -1200,7 +637,7 @@ def quasi_steady(
     warnings: list[str] = []
     n = orbit.mean_motion_rad_s
     samples = orbit_samples(orbit, attitude, atmosphere.date64())
-    rho_atm, atm_model, fallback = _density(samples, atmosphere)
+    rho_atm, atm_model, fallback = density(samples, atmosphere)
     if fallback:
         warnings.append(f"atmosphere: the exponential model is used because {fallback}")
     beta = drag.beta(mass)

@@ -152,12 +152,6 @@ def third_octave_bands(fmin_hz: float = 0.01, fmax_hz: float = 316.3, base: int 
     return BandTable(center_hz=center, lower_hz=center / half, upper_hz=center * half)
 
 
-def _data_comments(text: str) -> str:
-    """The ``#`` header of a shipped data file, joined into one line (its citation)."""
-    lines = [ln.lstrip("# ").strip() for ln in text.splitlines() if ln.startswith("#")]
-    return " ".join(ln for ln in lines if ln)
-
-
 @lru_cache(maxsize=1)
 def iss_requirement() -> Requirement:
     """ISS vibratory requirement as NASA PIMS codes it (``data/iss_requirement.csv``).

@@ -34,7 +34,6 @@ __all__ = [
     "TransientCheck",
     "TransientVerdict",
     "transient_criteria",
-    "transient_criteria_names",
     "load_transient_criteria",
     "judge_transient",
 ]
@@ -261,11 +260,6 @@ def _parse_sets(data: Mapping[str, Any], origin: str) -> dict[str, TransientCrit
 def _shipped() -> dict[str, TransientCriteria]:
     text = resources.files("microg").joinpath("data/transient_criteria.toml").read_text("utf-8")
     return _parse_sets(tomllib.loads(text), "microg/data/transient_criteria.toml")
-
-
-def transient_criteria_names() -> tuple[str, ...]:
-    """Names of the shipped criteria sets."""
-    return tuple(_shipped())
 
 
 def transient_criteria(name: str | TransientCriteria = "iss") -> TransientCriteria:

@@ -29,6 +29,7 @@ from typing import Any
 
 import numpy as np
 
+from microg._json import finite_list, finite_or_none
 from microg._vectors import AXIS_NAMES
 from microg.dynamics.frequency import BandResponse, band_response, damping_ratios
 from microg.dynamics.modes import Modes
@@ -41,14 +42,6 @@ __all__ = ["VibratoryAssessment", "assess_sources"]
 
 #: default number of modes listed per band in ``contributions``
 MAX_MODES_LISTED = 10
-
-
-def _clean(a: Any) -> list[Any]:
-    return [float(v) if np.isfinite(v) else None for v in np.ravel(np.asarray(a, float))]
-
-
-def _num(v: float) -> float | None:
-    return float(v) if np.isfinite(v) else None
 
 
 @dataclass(frozen=True)
@@ -127,13 +120,13 @@ class VibratoryAssessment:
             }
         return {
             "third_octave": {
-                "center_hz": _clean(self.center_hz),
-                "lower_hz": _clean(self.lower_hz),
-                "upper_hz": _clean(self.upper_hz),
-                "rms_g": _clean(worst_rms),
-                "limit_g": _clean(self.limit_g),
-                "margin": _clean(worst_margin),
-                "rms_g_axis": {a: _clean(rms[j]) for j, a in enumerate(self.axes)},
+                "center_hz": finite_list(self.center_hz),
+                "lower_hz": finite_list(self.lower_hz),
+                "upper_hz": finite_list(self.upper_hz),
+                "rms_g": finite_list(worst_rms),
+                "limit_g": finite_list(self.limit_g),
+                "margin": finite_list(worst_margin),
+                "rms_g_axis": {a: finite_list(rms[j]) for j, a in enumerate(self.axes)},
                 "axis": [self.axes[int(j)] for j in gov],
             },
             "complies": bool(self.complies[i]),
@@ -202,14 +195,14 @@ class VibratoryAssessment:
         return {
             "requirement": self.requirement,
             "requirement_source": self.requirement_source,
-            "zeta": float(el[0]) if el.size and np.all(el == el[0]) else _clean(self.zeta),
+            "zeta": float(el[0]) if el.size and np.all(el == el[0]) else finite_list(self.zeta),
             "duty_weighted": self.duty_weighted,
             "illustrative_sources": self.illustrative,
             "sources": [s.to_dict() for s in self.sources],
             "excluded_sources": list(self.excluded),
             "modes": {
                 "count": int(r.mode_freq_hz.size),
-                "highest_hz": _num(float(np.max(r.mode_freq_hz, initial=0.0))),
+                "highest_hz": finite_or_none(float(np.max(r.mode_freq_hz, initial=0.0))),
             },
             "band_integration": {
                 "method": "composite Gauss-Legendre, graded at every natural frequency, "

@@ -3,10 +3,12 @@
 The report's conclusions 6, 7 and 9 (Section 5, Figure 9).  Modules, one concept each:
 :mod:`~microg.location.sampling` (samples along the structure, straight lines, nodes),
 :mod:`~microg.location.peaks` (Eq. 3.1 peak factors, the rigid-body part, the time grid, the
-elastic rule), :mod:`~microg.location.amap` (the acceleration map, the peaks at one point,
-the best location, :func:`locate`), :mod:`~microg.location.layout` (movable masses and the
-optimiser); figures in :mod:`microg.plotting.location`, the conclusion-7 reproduction in
-:mod:`microg.seed.conclusion7`.  See ``docs/locate.md``.
+elastic rule, the peaks at points), :mod:`~microg.location.mapping` (the acceleration map
+and its best location), :mod:`~microg.location.site` (the peaks at one named point),
+:mod:`~microg.location.pipeline` (:func:`locate`, from a model), :mod:`~microg.location.layout`
+(movable masses and the optimiser); :mod:`~microg.location.amap` gathers the names of the
+map, the site and the pipeline.  Figures in :mod:`microg.plotting.location`, the
+conclusion-7 reproduction in :mod:`microg.seed.conclusion7`.  See ``docs/locate.md``.
 
 :func:`locate` takes stations and imported models alike: a modal model is mapped over its
 grids (named points added as carrier ``"points"``), a NASTRAN deck over its nodes, with the
@@ -14,16 +16,6 @@ nodes of the fundamental along the straight chains of its beams and rods
 (:func:`~microg.location.sampling.element_lines`).
 """
 
-from microg.location.amap import (
-    AccelerationMap,
-    LocateResult,
-    Location,
-    SitePeak,
-    acceleration_map,
-    best_location,
-    locate,
-    point_peak,
-)
 from microg.location.layout import (
     LayoutResult,
     MovableMass,
@@ -32,7 +24,10 @@ from microg.location.layout import (
     move_masses,
     optimize_layout,
 )
+from microg.location.mapping import AccelerationMap, Location, acceleration_map, best_location
+from microg.location.pipeline import LocateResult, locate
 from microg.location.sampling import Node, SampleLine
+from microg.location.site import SitePeak, point_peak
 
 __all__ = [
     "AccelerationMap",

@@ -6,7 +6,7 @@ trial and error: it moves the point masses a model (or the caller) marks as mova
 (:func:`movable_masses`, :func:`move_masses`) and minimises the peak acceleration that a crew
 force causes at the experiment site (:func:`optimize_layout`).
 
-The objective is the peak at the site of :func:`microg.location.amap.point_peak` -- the same
+The objective is the peak at the site of :func:`microg.location.site.point_peak` -- the same
 kernel as the acceleration map -- on the model discretised by the one entry
 :func:`microg.structure.discretize.discretize` (free-free) and solved by
 :func:`microg.dynamics.modes.solve_modes`.  By default it is the **total** peak (rigid-body
@@ -31,12 +31,13 @@ import numpy as np
 
 from microg.dynamics.crew import CrewPushoff
 from microg.errors import InputError
-from microg.location.amap import (
-    SitePeak,
+from microg.location.pipeline import (
+    check_point,
+    default_point,
     force_to_dict,
     location_structure,
-    point_peak,
 )
+from microg.location.site import SitePeak, point_peak
 from microg.models.station import Beam, NamedPoint, PointMass, RigidBody, Station
 from microg.structure.structure import Structure
 from microg.units import G0
@@ -63,7 +64,7 @@ MAX_GENERATIONS = 1000
 MAX_POPSIZE = 100
 #: largest number of movable masses
 MAX_MOVABLE = 20
-#: objectives the optimiser accepts (see :class:`~microg.location.amap.SitePeak`)
+#: objectives the optimiser accepts (see :class:`~microg.location.site.SitePeak`)
 LAYOUT_MEASURES = ("total", "elastic", "bound")
 #: defaults of :func:`optimize_layout` (and of ``microg optimize``)
 DEFAULTS: dict[str, Any] = {
@@ -118,7 +119,7 @@ class LayoutResult:
     experiment, crew : str
         Named points: the site and where the force acts.
     method, plane : str
-        Discretisation (see :func:`~microg.location.amap.location_structure`).
+        Discretisation (see :func:`~microg.location.pipeline.location_structure`).
     n : int or None
         Functions or elements per beam asked for.
     direction : ndarray (3,)
@@ -481,7 +482,7 @@ def layout_objective(
     """The peaks at the experiment site for the layout of ``station`` (the reference route).
 
     ``discretize(station, method, plane=..., n=n, gravity_gradient=False)``, then
-    ``solve_modes``, then :func:`~microg.location.amap.point_peak`: the total peak over time
+    ``solve_modes``, then :func:`~microg.location.site.point_peak`: the total peak over time
     (rigid + elastic), its elastic and rigid parts, and the bound (rigid + Eq. 3.1 summed
     over the elastic modes, exact [A]max).
 
@@ -663,7 +664,7 @@ def optimize_layout(
     """Move the movable masses to minimise the crew-induced peak at an experiment site.
 
     The objective is the site's ``measure`` (default ``total``: the peak over time of the
-    modal sum, rigid-body modes included) from :func:`~microg.location.amap.point_peak`, on
+    modal sum, rigid-body modes included) from :func:`~microg.location.site.point_peak`, on
     the layout's model (report conclusion 9).  A seeded
     ``scipy.optimize.differential_evolution`` over the bounds finds the basin (the elastic
     part is multimodal: it is near zero wherever a node of a mode crosses the site), then
@@ -710,7 +711,6 @@ def optimize_layout(
     from scipy.optimize import differential_evolution, minimize
 
     from microg.dynamics.modes import solve_modes
-    from microg.location.amap import check_point, default_point
 
     if measure not in LAYOUT_MEASURES:
         raise InputError(

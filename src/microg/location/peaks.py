@@ -15,12 +15,15 @@ is ``sum_j phi_j(s).d eta_j''(t)``.  This module gives
   grid of :data:`POINTS_PER_PERIOD` points per period of the fastest mode plus both sides of
   every force jump;
 * :func:`elastic_modes`: which modes are elastic -- the one rule, ``Modes.elastic`` where
-  the modes define it, else every mode that is not an exact rigid-body mode.
+  the modes define it, else every mode that is not an exact rigid-body mode;
+* :func:`point_peaks`: all of these at a set of points at once (the kernel of the map and of
+  the peaks at one point), for the modes :func:`kept_modes` keeps.
 """
 
 from __future__ import annotations
 
-from typing import Any
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -28,15 +31,21 @@ from microg.dynamics.crew import CrewPushoff, accel_amax
 from microg.dynamics.response import modal_pwl_response
 from microg.errors import InputError
 
+if TYPE_CHECKING:
+    from microg.dynamics.modes import Modes
+
 __all__ = [
     "MAX_TIMEPTS",
     "POINTS_PER_PERIOD",
+    "PointPeaks",
     "elastic_mask",
     "elastic_modes",
     "force_breakpoints",
+    "kept_modes",
     "max_force",
     "mode_peak_factors",
     "peak_over_time",
+    "point_peaks",
     "rigid_part",
     "time_grid",
 ]
@@ -246,3 +255,105 @@ def peak_over_time(r: np.ndarray, eta_ddot: np.ndarray) -> np.ndarray:
         a = r @ eta_ddot[:, start : start + block]
         np.maximum(out, np.max(np.abs(a), axis=1), out=out)
     return out
+
+
+@dataclass(frozen=True)
+class PointPeaks:
+    """Every peak of the map at a set of points (see :func:`point_peaks`), m/s^2.
+
+    Attributes
+    ----------
+    per_mode : ndarray (m, p)
+        Eq. 3.1 per mode and point.
+    total, elastic, rigid, bound : ndarray (p,)
+        Peak over time of the modal sum, of its elastic modes, the exact rigid-body part,
+        and ``rigid`` plus the per-mode peaks of the other modes (an upper bound).
+    long_time : ndarray (p,) or None
+        The supremum over all t >= 0 of an undamped response to a force ending at zero.
+    grid : ndarray
+        The time grid of the peaks over time, s.
+    exact : bool
+        Whether ``per_mode`` is the closed form (exact [A]max).
+    """
+
+    per_mode: np.ndarray
+    total: np.ndarray
+    elastic: np.ndarray
+    rigid: np.ndarray
+    bound: np.ndarray
+    long_time: np.ndarray | None
+    grid: np.ndarray
+    exact: bool
+
+
+def point_peaks(
+    resp: np.ndarray,
+    gamma: np.ndarray,
+    omega: np.ndarray,
+    rigid: np.ndarray,
+    elastic: np.ndarray,
+    zeta: np.ndarray,
+    force: Any,
+    duration: float | None,
+    *,
+    with_long_time: bool = True,
+) -> PointPeaks:
+    """Every peak of the map at points with responses ``resp`` (p, m) per modal coordinate.
+
+    Parameters
+    ----------
+    resp : ndarray (p, m)
+        Displacement along the force direction per unit modal coordinate, m/sqrt(kg).
+    gamma : ndarray (m,)
+        The force's participation ``phi_j(crew).d``, 1/sqrt(kg).
+    omega : ndarray (m,)
+        rad/s.
+    rigid, elastic : ndarray (m,) of bool
+    zeta : ndarray (m,)
+        Damping ratios.
+    force : CrewPushoff or ForceHistory
+        N.
+    duration : float or None
+        Time window, s (default: :func:`time_grid`'s).
+    with_long_time : bool
+        Also the long-time peak (undamped models whose force ends at zero).
+    """
+    peaks, exact = mode_peak_factors(omega, force, zeta, elastic=elastic)
+    per_mode = np.abs(resp.T) * np.abs(gamma)[:, None] * peaks[:, None]
+    tb, fb = force_breakpoints(force)
+    grid = time_grid(tb, omega, elastic, duration)
+    modal = modal_pwl_response(omega, zeta, tb, np.outer(gamma, fb), grid)
+    total = peak_over_time(resp, modal.eta_ddot)
+    el_peak = peak_over_time(resp[:, elastic], modal.eta_ddot[elastic])
+    rig = rigid_part(resp, gamma, rigid, force)
+    bound = rig + per_mode[~rigid].sum(axis=0)
+    long_time = None
+    if with_long_time and np.all(zeta == 0) and fb[-1] == 0 and omega.size:
+        end = modal_pwl_response(omega, zeta, tb, np.outer(gamma, fb), tb[-1:])
+        amp = omega * np.hypot(omega * end.eta[:, 0], end.eta_dot[:, 0])
+        long_time = np.maximum(total, np.abs(resp) @ np.abs(amp))
+    return PointPeaks(per_mode, total, el_peak, rig, bound, long_time, grid, exact)
+
+
+def kept_modes(
+    modes: Modes, zeta: float | np.ndarray, include_rigid: bool
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(use, omega, rigid, elastic, zeta) of the modes kept, the damping validated.
+
+    Parameters
+    ----------
+    modes : Modes
+        The solved modes (omega in rad/s).
+    zeta : float or ndarray (m,)
+        Modal damping ratios, 0 <= zeta < 1.
+    include_rigid : bool
+        Keep the rigid-body modes.
+    """
+    omega = np.asarray(modes.omega, float)
+    rigid = np.asarray(modes.rigid, bool)
+    zeta_arr = np.broadcast_to(np.asarray(zeta, float), omega.shape).astype(float)
+    if np.any(~np.isfinite(zeta_arr)) or np.any(zeta_arr < 0) or np.any(zeta_arr >= 1):
+        raise InputError("damping ratio must satisfy 0 <= zeta < 1", where="zeta")
+    use = np.ones(omega.size, bool) if include_rigid else ~rigid
+    elastic = elastic_modes(modes)
+    return use, omega[use], rigid[use], elastic[use], zeta_arr[use]

@@ -4,7 +4,7 @@ Conclusion 7 of the seed report (Section 5): removing the orbiter moves the node
 fundamental X-Z bending mode next to the laboratory (z = -55 ft), so the lab's acceleration
 from a crew push-off falls "by about 3 orders".  This module recomputes it on the shipped
 models ``ioc`` and ``ioc-no-orbiter`` with the report's own model (X-Z plane, one assumed
-function per beam), through the location stage (:func:`microg.location.amap.locate`'s
+function per beam), through the location stage (:func:`microg.location.pipeline.locate`'s
 pipeline), and compares with the report's printed Table 4 ratio
 (``data/_seed_printed.toml``).  ``docs/locate.md`` states what holds and what does not.
 """
@@ -18,14 +18,10 @@ from typing import Any
 import numpy as np
 
 from microg.dynamics.crew import CrewPushoff
-from microg.location.amap import (
-    AccelerationMap,
-    acceleration_map,
-    best_location,
-    location_structure,
-    point_peak,
-)
+from microg.location.mapping import AccelerationMap, acceleration_map, best_location
 from microg.location.peaks import elastic_modes
+from microg.location.pipeline import location_structure
+from microg.location.site import point_peak
 from microg.models.station import Station
 from microg.units import G0
 

@@ -1,7 +1,7 @@
 """The errata of the seed report: each printed value beside microg's, and the reason.
 
-Built from a :class:`~microg.seed.reproduce.Reproduction` and its comparisons
-(:mod:`microg.seed.agreement`): one entry per printed value that differs from its
+Built from the comparisons of a reproduction (:mod:`microg.seed.comparison`) and its recomputed
+tables (:mod:`microg.seed.tables`): one entry per printed value that differs from its
 recomputation by more than its tolerance, with the computed reason (for example a printed
 libration acceleration is called "twice Eq. 3.2" only when it is twice the recomputed value
 within the tolerance), then the OCR corrections, what Table 4 leaves out, and the errors of
@@ -10,14 +10,12 @@ the text.  Every entry has an id (``E1``, ``E2``, ...) that the comparisons link
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING
 
-from microg.seed.agreement import CASE_NAMES, Comparison
+from microg.seed.comparison import CASE_NAMES, Comparison
 from microg.seed.ioc import printed
-
-if TYPE_CHECKING:
-    from microg.seed.reproduce import Reproduction
+from microg.seed.tables import Table4Case
 
 __all__ = ["ErrataEntry", "build_errata"]
 
@@ -54,16 +52,19 @@ class ErrataEntry:
 
 
 def build_errata(
-    rep: Reproduction, comparisons: list[Comparison]
+    comparisons: list[Comparison], *, cases: Sequence[str], table4: Mapping[str, Table4Case]
 ) -> tuple[list[ErrataEntry], list[Comparison]]:
     """The errata, and the comparisons with their errata ids set.
 
     Parameters
     ----------
-    rep : Reproduction
-        The recomputation (its ``errata`` and ``comparisons`` may be empty).
     comparisons : list of Comparison
         Every printed value compared (:func:`microg.seed.agreement.build_comparisons`).
+    cases : sequence of str
+        The Appendix C cases recomputed (keys of :data:`microg.seed.ioc.CASES`), in order:
+        each brings its OCR corrections.
+    table4 : mapping
+        Case -> its recomputed Table 4 (the rigid translation and libration, g).
     """
     out: list[ErrataEntry] = []
     linked: list[Comparison] = []
@@ -91,7 +92,7 @@ def build_errata(
             )
         )
         linked.append(replace(cmp, erratum=eid))
-    for case in rep.appendix_c:
+    for case in cases:
         for (i, j), ocr in _ocr(case).items():
             add(
                 ErrataEntry(
@@ -105,8 +106,8 @@ def build_errata(
                     cause="OCR damage",
                 )
             )
-    if rep.table4:
-        xo = rep.table4.get("xz_orbiter") or next(iter(rep.table4.values()))
+    if table4:
+        xo = table4.get("xz_orbiter") or next(iter(table4.values()))
         add(
             ErrataEntry(
                 "Eq. 3.1 / Table 4",

@@ -8,17 +8,11 @@ couples with yaw; microg follows the report and says so in the errata.)
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
-
-from microg.dynamics.crew import CrewPushoff, accel_amax, acceleration_a
 
 __all__ = [
     "orbital_rate",
     "libration_frequencies",
-    "LibrationResponse",
-    "libration_response",
     "libration_accel_impulse",
 ]
 
@@ -82,73 +76,3 @@ def libration_accel_impulse(
         Moment of inertia about the libration axis through the centre of mass, kg m^2.
     """
     return abs(z_e * z_a) * f0 * omega * t1 / (2.0 * inertia)
-
-
-@dataclass(frozen=True)
-class LibrationResponse:
-    """Exact librational response to the full crew force history.
-
-    Attributes
-    ----------
-    omega : float
-        Libration frequency, rad/s.
-    timepts : ndarray
-        s.
-    theta : ndarray
-        Libration angle, rad.
-    accel : ndarray
-        Acceleration at the observation point, m/s^2.
-    peak_accel : float
-        Exact max over all t of |accel|, m/s^2 (push-off and landing both included).
-    peak_accel_impulse : float
-        The report's impulse estimate (push-off only, Eq. 3.2), m/s^2.
-    """
-
-    omega: float
-    timepts: np.ndarray
-    theta: np.ndarray
-    accel: np.ndarray
-    peak_accel: float
-    peak_accel_impulse: float
-
-
-def libration_response(
-    crew: CrewPushoff,
-    omega: float,
-    inertia: float,
-    z_e: float,
-    z_a: float,
-    timepts: np.ndarray,
-) -> LibrationResponse:
-    """Libration from the crew force f(t) applied at lever arm ``z_a`` (Eqs. 2.28, 2.31).
-
-    The torque ``z_a f(t)`` has the shape of Eq. 2.16, so ``theta`` is the closed form
-    ``z_a/I f0/(w^3 t1) U(t)`` and the acceleration at ``z_e`` is ``z_e theta''``.
-
-    Parameters
-    ----------
-    crew : CrewPushoff
-    omega : float
-        Libration frequency, rad/s.
-    inertia : float
-        kg m^2.
-    z_e, z_a : float
-        Lever arms of the observation point and the force about the centre of mass, m.
-    timepts : ndarray
-        s.
-    """
-    from microg.dynamics.crew import displacement_u
-
-    scale_u = z_a / inertia * crew.f0 / (omega**3 * crew.t1)
-    scale_a = z_a / inertia * crew.f0 / (omega * crew.t1)
-    theta = scale_u * displacement_u(omega, timepts, crew)
-    accel = z_e * scale_a * acceleration_a(omega, timepts, crew)
-    peak = abs(z_e * scale_a) * float(accel_amax(omega, crew))
-    return LibrationResponse(
-        omega=omega,
-        timepts=np.asarray(timepts, float),
-        theta=theta,
-        accel=accel,
-        peak_accel=peak,
-        peak_accel_impulse=libration_accel_impulse(z_e, z_a, crew.f0, crew.t1, omega, inertia),
-    )

@@ -895,7 +895,7 @@ def run_blocks(
 
 
 def kernel_plan(study: Any) -> KernelPlan:
-    """The KernelPlan of a :class:`~microg.study.plan.Study`."""
+    """The KernelPlan of a :class:`~microg.study.cases.Study`."""
     return KernelPlan(
         timepts=study.record.timepts,
         requirement=requirement_by_name(study.record.requirement),

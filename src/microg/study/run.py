@@ -33,8 +33,9 @@ import numpy as np
 
 from microg._io import sigterm_raises
 from microg.errors import InputError, MicrogError
+from microg.study.cases import Block, Study, default_n_modes
 from microg.study.kernel import Basis, BlockWork, KernelPlan, kernel_plan, run_blocks, solve_basis
-from microg.study.plan import Block, Study, default_n_modes, load_study
+from microg.study.plan import load_study
 from microg.study.store import STORE_NAME, SweepStore
 
 if TYPE_CHECKING:

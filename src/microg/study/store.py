@@ -3,14 +3,14 @@
 Layout (zarr format 2, consolidated metadata; ``xarray.open_zarr(DIR/results.zarr)`` reads it
 as one labelled Dataset):
 
-* one dimension per axis of the study (:data:`~microg.study.plan.CASE_DIMS`), plus ``axis``
+* one dimension per axis of the study (:data:`~microg.study.cases.CASE_DIMS`), plus ``axis``
   (x, y, z) and ``band`` (the requirement's 1/3-octave bands below Nyquist, by centre, Hz);
 * variables ``peak_accel_g``, ``rms_accel_g`` (magnitude), ``peak_accel_g_axis``,
   ``rms_accel_g_axis`` (per axis), ``band_rms_g`` (per axis and band), ``margin`` (the worst
   ``limit / band RMS`` over the judged bands and axes), ``complies`` and ``computed`` (the case
   is in the plan and its block is written); band coordinates ``band_lower_hz``,
   ``band_upper_hz``, ``limit_g`` and ``judged`` (the bands the record resolves);
-* one chunk per variable and block (:meth:`~microg.study.plan.Study.block`): a block's values
+* one chunk per variable and block (:meth:`~microg.study.cases.Study.block`): a block's values
   are written whole, by one writer (the process that runs the sweep), ``computed`` last;
 * ``sweep/done`` (a zarr array beside the Dataset, one flag per block id) records the finished
   blocks; a block is marked done only after its values are written, so a sweep that stops
@@ -30,8 +30,9 @@ from typing import Any
 
 import numpy as np
 
+from microg._io import to_jsonable
 from microg.errors import InputError
-from microg.study.plan import CASE_DIMS, Block, Study
+from microg.study.cases import CASE_DIMS, Block, Study
 
 __all__ = ["VARIABLES", "STORE_NAME", "SweepStore", "band_table"]
 
@@ -159,7 +160,7 @@ class SweepStore:
             "study_sha256": s.sha256,
             "fingerprint": s.fingerprint,
             "study_text": s.text,
-            "study_json": json.dumps(_jsonable(s.to_dict())),
+            "study_json": json.dumps(to_jsonable(s.to_dict())),
             "requirement": req.name,
             "requirement_source": req.source,
             "duration_s": s.record.duration_s,
@@ -216,7 +217,7 @@ class SweepStore:
         """Keep the modes of a solved variant in the store's attributes."""
         sub = self._group["sweep"]
         bases = dict(sub.attrs.get("bases", {}))
-        bases["/".join(key)] = _jsonable(info)
+        bases["/".join(key)] = to_jsonable(info)
         sub.attrs.update({"bases": bases, "updated_utc": _now()})
 
     def bases(self) -> dict[str, Any]:
@@ -252,9 +253,3 @@ class SweepStore:
         import xarray as xr
 
         return xr.open_zarr(self._store, consolidated=True)
-
-
-def _jsonable(obj: Any) -> Any:
-    from microg._io import to_jsonable
-
-    return to_jsonable(obj)

@@ -15,17 +15,17 @@ whatever the size of the study), and keeps:
 from __future__ import annotations
 
 import shlex
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from pathlib import Path
+from typing import Any, Protocol
 
 import numpy as np
 
+from microg._json import json_number
 from microg.errors import InputError
-from microg.study.plan import CASE_DIMS, Study, default_n_modes
-
-if TYPE_CHECKING:
-    from microg.study.run import SweepResult
+from microg.study.cases import CASE_DIMS, Study, default_n_modes
+from microg.study.store import SweepStore
 
 __all__ = [
     "Summary",
@@ -36,6 +36,38 @@ __all__ = [
     "model_file",
     "check_heatmap",
 ]
+
+
+class SweepRecord(Protocol):
+    """What a summary reads of a sweep (:class:`microg.study.run.SweepResult` is one).
+
+    The summary depends on the plan and the store only, never on the runner that wrote them.
+    """
+
+    @property
+    def study(self) -> Study:
+        """The plan."""
+
+    @property
+    def store(self) -> SweepStore:
+        """The results, block by block."""
+
+    @property
+    def out(self) -> Path | None:
+        """The output directory (None: in memory)."""
+
+    @property
+    def bases(self) -> Mapping[str, Any]:
+        """``"model/variant"`` -> the modes in its response (JSON-ready)."""
+
+    @property
+    def warnings(self) -> Sequence[str]:
+        """What the user should know."""
+
+    @property
+    def dataset(self) -> Any:
+        """The results as a labelled ``xarray.Dataset``."""
+
 
 #: requirement names as ``microg analyze --requirement`` spells them
 _CLI_REQUIREMENT = {"iss": "iss", "ssp41000": "ssp41000", "flat": "flat", "report-1e-5g": "flat"}
@@ -95,7 +127,7 @@ class Summary:
             "heatmap": {
                 "dims": list(self.heatmap_dims),
                 "labels": [list(x) for x in self.heatmap_labels],
-                "margin": [[_num(v) for v in row] for row in self.heatmap],
+                "margin": [[json_number(v) for v in row] for row in self.heatmap],
             },
             "fraction_by": {
                 k: [{"value": lab, "complying_fraction": fr} for lab, fr in v]
@@ -148,14 +180,6 @@ class Summary:
         return heatmap_figure(self, ax=ax)
 
 
-def _num(v: float) -> float | str | None:
-    if np.isnan(v):
-        return None
-    if np.isinf(v):
-        return "inf" if v > 0 else "-inf"
-    return float(v)
-
-
 def _sort_key(row: dict[str, Any]) -> tuple[float, float]:
     m = row["margin"]
     key = -np.inf if m is None else (np.inf if m == "inf" else float(m))
@@ -197,13 +221,13 @@ def check_heatmap(study: Study, dims: Sequence[str] | None) -> tuple[str, str]:
 
 
 def summarize(
-    result: SweepResult, heatmap: Sequence[str] | None = None, n_worst: int = 5
+    result: SweepRecord, heatmap: Sequence[str] | None = None, n_worst: int = 5
 ) -> Summary:
     """The summary of a sweep's results (one pass over the store, block by block).
 
     Parameters
     ----------
-    result : the SweepResult
+    result : the sweep (a :class:`~microg.study.run.SweepResult`)
     heatmap : the two axes of the heat map (default: :func:`default_heatmap`)
     n_worst : worst cases kept per observed point
     """
@@ -310,7 +334,7 @@ def summarize(
     )
 
 
-def _case_row(result: SweepResult, ds: Any, case: tuple[int, ...]) -> dict[str, Any]:
+def _case_row(result: SweepRecord, ds: Any, case: tuple[int, ...]) -> dict[str, Any]:
     study = result.study
     labels = study.case(case)
     point = ds.isel(dict(zip(CASE_DIMS, case, strict=True)))
@@ -332,7 +356,7 @@ def _case_row(result: SweepResult, ds: Any, case: tuple[int, ...]) -> dict[str, 
     return {
         "case": {k: (float(v) if k == "damping" else v) for k, v in labels.items()},
         "index": [int(i) for i in case],
-        "margin": _num(float(point.margin.values)),
+        "margin": json_number(float(point.margin.values)),
         "peak_accel_g": float(point.peak_accel_g.values),
         "rms_accel_g": float(point.rms_accel_g.values),
         "complies": bool(point.complies.values),
@@ -343,7 +367,7 @@ def _case_row(result: SweepResult, ds: Any, case: tuple[int, ...]) -> dict[str, 
     }
 
 
-def _items(result: SweepResult, labels: dict[str, Any]) -> tuple[Any, Any]:
+def _items(result: SweepRecord, labels: dict[str, Any]) -> tuple[Any, Any]:
     """The model item (the variant's file, or the study's model) and the variant of a case."""
     study = result.study
     im = study.coords["model"].index(labels["model"])
@@ -353,7 +377,7 @@ def _items(result: SweepResult, labels: dict[str, Any]) -> tuple[Any, Any]:
     return item, v
 
 
-def _model_ref(result: SweepResult, labels: dict[str, Any]) -> tuple[str | None, str]:
+def _model_ref(result: SweepRecord, labels: dict[str, Any]) -> tuple[str | None, str]:
     """(path for ``microg analyze``, or None when the CLI cannot load it; Python expression)."""
     study = result.study
     m = study.models[study.coords["model"].index(labels["model"])]
@@ -381,7 +405,7 @@ def model_file(model: str, variant: str) -> str:
     return safe_filenames([key])[key] + ".toml"
 
 
-def case_command(result: SweepResult, labels: dict[str, Any]) -> str | None:
+def case_command(result: SweepRecord, labels: dict[str, Any]) -> str | None:
     """The ``microg analyze`` command line that reproduces one case alone (no isolator).
 
     A source catalogue's case is ``microg analyze --sources FILE``.  None when the model
@@ -422,7 +446,7 @@ def case_command(result: SweepResult, labels: dict[str, Any]) -> str | None:
     return " ".join(shlex.quote(a) for a in args)
 
 
-def case_python(result: SweepResult, labels: dict[str, Any]) -> str:
+def case_python(result: SweepRecord, labels: dict[str, Any]) -> str:
     """The Python call that reproduces one case alone with :func:`microg.analyze`."""
     study = result.study
     _, model = _model_ref(result, labels)

@@ -1,10 +1,9 @@
-"""Tests of microg.environment.metrics: PSD, 1/3-octave band RMS, resolution, DC, integrals.
+"""Tests of microg.environment.assessment: assess (PSD, 1/3-octave bands, resolution, DC).
 
 References: Parseval's theorem (mean square of a sum of sinusoids = sum of A^2/2), the RMS of a
 sinusoid (A/sqrt 2), the boxcar window's spectral leakage (the integral of sinc^2, from
-scipy.special.sici), analytic integrals of constant and sinusoidal accelerations, and an
-explicit block-by-block implementation of PIMS's ``file_trapz`` (baluneboy/pims,
-transient/main.py).
+scipy.special.sici), analytic integrals of constant and sinusoidal accelerations.  The
+names are imported from microg.environment.metrics, the path users import them by.
 """
 
 from __future__ import annotations
@@ -16,15 +15,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from matplotlib.figure import Figure
-from scipy import integrate
 
 from microg.environment.metrics import (
     acceleration_psd,
     assess,
-    band_mean_square,
     band_rms,
-    integrated_acceleration,
-    integrated_acceleration_pims,
     json_number,
 )
 from microg.environment.requirements import (
@@ -268,51 +263,6 @@ def test_requirement_by_name():
 # ----------------------------------------------------------------------------- integrals
 
 
-def test_integrated_acceleration_sliding():
-    t = np.linspace(0, 30, 3001)
-    ia = integrated_acceleration(t, np.full(t.size, 0.2))
-    assert ia.max_mps[0] == pytest.approx(2.0, rel=1e-12)  # 0.2 m/s^2 * 10 s, exact
-    # sinusoid of period 20 s: the 10-s window over half a period gives 2 A / w
-    w, amp = 2 * np.pi / 20, 1e-4
-    ia = integrated_acceleration(t, amp * np.sin(w * t))
-    # trapezoid error (w dt)^2 / 12 = 8e-7 relative on a 0.01 s grid
-    assert ia.max_mps[0] == pytest.approx(2 * amp / w, rel=2e-6)
-    short = integrated_acceleration(t[:501], np.ones(501))
-    assert short.window_s == pytest.approx(5.0) and short.max_mps[0] == pytest.approx(5.0)
-
-
-def _pims_file_trapz_reference(a: np.ndarray, fs: float, sec: float) -> np.ndarray:
-    """PIMS's file_trapz written out block by block (transient/main.py of baluneboy/pims)."""
-    b = a - a.mean(axis=1, keepdims=True)  # "demean signal" over the whole file
-    dt = 1.0 / fs
-    nt = int(np.ceil(sec / dt))
-    out = []
-    start = 0
-    while start + nt <= b.shape[1]:  # the incomplete last block is deleted
-        out.append([integrate.trapezoid(row[start : start + nt], dx=dt) for row in b])
-        start += nt
-    return np.array(out).T
-
-
-def test_integrated_acceleration_pims_matches_block_reference():
-    rng = np.random.default_rng(3)
-    fs = 142.0  # the sample rate of a SAMS 121f03 PAD file
-    t = np.arange(int(47.3 * fs)) / fs  # 4 complete 10-s blocks and a partial one
-    a = 1e-5 * rng.standard_normal((3, t.size)) + np.array([[3e-4], [0.0], [-1e-4]])
-    got = integrated_acceleration_pims(t, a, 10.0, sample_rate_hz=fs)
-    ref = _pims_file_trapz_reference(a, fs, 10.0)
-    assert got.block_samples == 1420 and got.n_blocks == 4
-    # same arithmetic in another order: 1e-12 of the block integrals' scale
-    scale = np.max(np.abs(ref))
-    assert np.allclose(got.delta_v, ref, rtol=0, atol=1e-12 * scale)
-    assert np.allclose(got.max_mps, np.max(np.abs(ref), axis=1), rtol=1e-12)
-    # a constant is the quasi-steady part: demeaned, it integrates to nothing in PIMS's
-    # definition, while microg's sliding window keeps it (conservative)
-    c = np.full((1, t.size), 3e-4)
-    assert integrated_acceleration_pims(t, c, 10.0).max_mps[0] == pytest.approx(0.0, abs=1e-18)
-    assert integrated_acceleration(t, c, 10.0).max_mps[0] == pytest.approx(3e-3, rel=1e-9)
-
-
 def test_integrated_both_named_in_output():
     a = np.vstack([1e-4 * np.sin(2 * np.pi * TIME / 20), 0 * TIME, 0 * TIME])
     d = assess(TIME, a).to_dict()
@@ -459,122 +409,3 @@ def test_overlay_of_a_prediction_and_a_measurement():
     assert {"IOC lab x", "SAMS 121f03 x", "limit"} <= set(labels)
     assert len(fig.axes[1].lines) == 2  # one PSD each, the worst axis by RMS
     assert isinstance(pred.plot("psd"), Figure)
-
-
-@pytest.mark.parametrize("n", [1000, 1001, 4])
-def test_periodogram_is_scipys(n):
-    # reference: scipy.signal.periodogram with the same definition (boxcar, density, one-sided);
-    # both are one FFT, so they agree to rounding (1e-12 of the largest bin)
-    from scipy import signal
-
-    from microg.environment.metrics import _periodogram
-
-    rng = np.random.default_rng(n)
-    x = rng.standard_normal((3, n))
-    f_ref, p_ref = signal.periodogram(x, fs=50.0, window="boxcar", detrend=False, axis=-1)
-    f, p = _periodogram(x, 50.0)
-    assert np.array_equal(f, f_ref)
-    assert np.allclose(p, p_ref, rtol=0, atol=1e-12 * p_ref.max())
-
-
-def test_band_weights_integrate_the_piecewise_constant_psd_exactly():
-    # independent reference: a plain loop over bins and bands of the overlap length of each
-    # band with each bin [f_k - df/2, f_k + df/2] (clipped to [0, Nyquist]), the DC bin left
-    # out; rounding of a sum of a few thousand terms: 1e-12 relative
-    from microg.environment.metrics import Spectrum, band_weights
-    from microg.environment.requirements import BandTable
-
-    rng = np.random.default_rng(7)
-    for nf, df in ((513, 0.05), (1000, 0.013)):
-        f = np.arange(nf) * df
-        nyq = f[-1] if nf % 2 else f[-1] + df / 2
-        psd = rng.random((3, nf))
-        lo = np.r_[0.0, 0.5 * df, rng.uniform(0, nyq, 8), nyq - df / 3, nyq]
-        hi = lo + np.r_[df / 4, 3 * df, rng.uniform(0.01, 3.0, 8), df, 1.0]
-        bands = BandTable(np.sqrt(lo * hi + 1e-9), lo, hi)
-        ref = np.zeros((3, lo.size))
-        for b in range(lo.size):
-            lo_b, hi_b = min(lo[b], nyq), min(hi[b], nyq)
-            for k in range(1, nf):
-                a, c = max(f[k] - df / 2, 0.0), min(f[k] + df / 2, nyq)
-                ov = max(0.0, min(c, hi_b) - max(a, lo_b))
-                if c > a:
-                    ref[:, b] += psd[:, k] * df * ov / (c - a)
-        got = np.asarray(band_weights(f, df, nyq, bands) @ psd.T).T
-        np.testing.assert_allclose(got, ref, rtol=1e-12, atol=1e-15 * ref.max())
-        spec = Spectrum(f, psd, df, nyq, "periodogram")
-        keep = lo < nyq
-        np.testing.assert_allclose(
-            band_rms(spec, bands).rms, np.sqrt(ref[:, keep]), rtol=1e-12, atol=1e-15
-        )
-
-
-@pytest.mark.parametrize("n", [20001, 4096, 1000, 17])
-@pytest.mark.parametrize("wide", [False, True])
-def test_band_mean_square_equals_the_periodogram_band_sum(n, wide):
-    """Both paths (direct DFT of a few bins; the whole FFT) give W @ periodogram.
-
-    Reference: ``band_rms(acceleration_psd(...))`` (numpy's FFT), the definition itself.
-    Tolerance 1e-11 relative to the largest band: the direct sums of n terms round to
-    ~sqrt(n) eps of |x|^2 n.
-    """
-    rng = np.random.default_rng(n)
-    fs = 100.0
-    t = np.arange(n) / fs
-    x = rng.standard_normal((7, n)) + 3.0  # a mean, which neither path counts
-    df = fs / n
-    if wide:
-        bands = third_octave_bands(0.01, 50.0)  # many bins: the whole-FFT path
-    else:  # three narrow bands, a few bins each, edges between bins: the direct path
-        lo = np.array([3.3, 11.1, 20.05]) * df + 0.1
-        bands = BandTable(lo, lo, lo + np.array([4.6, 2.3, 9.9]) * df)
-    got = band_mean_square(t, x, bands)
-    ref = band_rms(acceleration_psd(t, x), bands).rms ** 2
-    keep = bands.lower_hz < fs / 2
-    assert got.shape == (7, bands.center_hz.size)
-    np.testing.assert_allclose(got[:, keep], ref, rtol=0, atol=1e-11 * ref.max())
-    assert np.all(got[:, ~keep] == 0.0)
-
-
-def test_band_mean_square_of_a_bin_centred_sine_is_half_its_square():
-    """Exact: a sine of amplitude A on bin k of a boxcar record has mean square A^2 / 2.
-
-    All of it falls in bin k (no leakage), so any band holding the whole bin returns
-    A^2 / 2 to rounding (1e-12).
-    """
-    n, fs, k, amp = 20001, 100.0, 40, 3.0
-    t = np.arange(n) / fs
-    f0 = k * fs / n
-    x = amp * np.sin(2 * np.pi * f0 * t)
-    bands = BandTable(np.array([f0]), np.array([f0 * 0.9]), np.array([f0 * 1.1]))
-    got = band_mean_square(t, x, bands)
-    assert got[0, 0] == pytest.approx(amp**2 / 2, rel=1e-12)
-
-
-def test_band_weights_are_kept_read_only_and_equal_a_fresh_computation():
-    """The kept map is the computed one (reference: the uncached kernel) and cannot change."""
-    from microg.environment.metrics import _band_weights, band_weights
-
-    f = np.fft.rfftfreq(2001, 0.01)
-    bands = third_octave_bands(0.1, 40.0)
-    w1 = band_weights(f, f[1], 50.0, bands)
-    w2 = band_weights(f.copy(), f[1], 50.0, bands)
-    assert w2 is w1  # the same inputs: the kept map
-    ref = _band_weights(f, f[1], 50.0, bands.lower_hz, bands.upper_hz)
-    assert (w1 != ref).nnz == 0
-    with pytest.raises(ValueError):
-        w1.data[0] = 1.0
-    other = band_weights(f, f[1], 50.0, third_octave_bands(0.2, 40.0))
-    assert other is not w1 and other.shape[0] < w1.shape[0]
-
-
-@pytest.mark.parametrize(
-    "bad, message",
-    [(np.nan, "not all finite"), (np.inf, "not all finite"), (0.0105, "uniformly spaced")],
-)
-def test_sample_rate_refuses_nonfinite_and_uneven_times(bad, message):
-    """A NaN or inf time anywhere (also mid-record) or an uneven step is refused by name."""
-    t = np.arange(100) * 0.01
-    t[50] = t[50] + bad if np.isfinite(bad) else bad
-    with pytest.raises(InputError, match=message):
-        acceleration_psd(t, np.ones(100))
