@@ -29,25 +29,14 @@ FLAGS = {
 
 
 def _default_modes() -> int:
-    from microg.dynamics import modes as mod
+    from microg.dynamics.modes import DEFAULT_N_MODES
 
-    return int(getattr(mod, "DEFAULT_N_MODES", 20))
+    return DEFAULT_N_MODES
 
 
 def _effective_percent(m: Any) -> dict[str, Any]:
-    frac = getattr(m, "effective_mass_fraction", None)
-    if frac is None:
-        import numpy as np
-
-        s = m.structure
-        out = {}
-        for d, r in s.rigid_body.items():
-            r = np.asarray(r, float)
-            total = float(r @ (s.mass @ r))
-            if d in m.effective_mass and total > 0:
-                out[d] = 100.0 * np.asarray(m.effective_mass[d]) / total
-        return out
-    return {d: 100.0 * v for d, v in (frac() if callable(frac) else frac).items()}
+    """Effective mass per rigid-body direction, percent of the total (``Modes``)."""
+    return {d: 100.0 * v for d, v in m.effective_mass_fraction.items()}
 
 
 @click.command()
@@ -85,8 +74,8 @@ def _effective_percent(m: Any) -> dict[str, Any]:
     "n_modes",
     type=Integer(1, 2000),
     default=None,
-    help="Number of lowest modes, at least the rigid-body ones (Ritz default: all; FE "
-    "default: 20).",
+    help="Number of lowest modes, at least the rigid-body ones (default: all of a dense "
+    "model, 60 of a sparse one).",
 )
 @click.option(
     "--gravity-gradient/--free-free",
@@ -252,14 +241,3 @@ def build_structure(
         )
     return station, discretize(station, "fem", n=elements)
 
-
-def solve_for_cli(structure: Any, method: str, plane: str | None, n_modes: int | None) -> Any:
-    """Modes for ``microg locate`` (transitional helper)."""
-    import microg
-    from microg.dynamics.planar import in_plane_modes
-
-    if method == "ritz" or plane is None:
-        return microg.solve_modes(structure, n_modes=n_modes or (None if method == "ritz" else 20))
-    want = n_modes or 20
-    ask = min(max(3 * want, want + 6), structure.n_dof)
-    return in_plane_modes(structure, microg.solve_modes(structure, n_modes=ask), plane, want)
