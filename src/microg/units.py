@@ -51,6 +51,7 @@ __all__ = [
     "parse_quantity",
     "parse_unit",
     "check_limit",
+    "is_plain_number",
 ]
 
 #: standard gravity, m/s^2 (used to express accelerations in g)
@@ -134,6 +135,15 @@ _NUMBER = re.compile(r"[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?
 _NON_FINITE = re.compile(r"[+-]?(?:nan|inf|infinity)(?![A-Za-z_])", re.IGNORECASE)
 _TOKEN = re.compile(r"\s*(?:(\*\*|[*/^()])|([^\W\d]\w*|%)|([+-]?[0-9]+))")
 _NAME_START = re.compile(r"[^\W\d]|%")
+
+
+def is_plain_number(text: str) -> bool:
+    """Whether ``text`` is one number of the quantity grammar (ASCII digits; nan/inf named).
+
+    Python's ``float`` also reads other scripts' digits and underscores; this does not.
+    """
+    t = text.strip()
+    return _NUMBER.fullmatch(t) is not None or _NON_FINITE.fullmatch(t) is not None
 
 
 # ------------------------------------------------------------------------------- registry

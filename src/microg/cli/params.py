@@ -13,7 +13,7 @@ from typing import Any
 import click
 
 from microg.errors import InputError
-from microg.units import G0, LIMITS, check_limit, parse_quantity
+from microg.units import G0, LIMITS, check_limit, is_plain_number, parse_quantity
 
 __all__ = [
     "QuantityType",
@@ -29,14 +29,18 @@ __all__ = [
 #: a plain number as written in ASCII: Python's own parsing also takes other scripts' digits
 #: ("\u0661\u0660" is 10) and underscores ("1_0" is 10), which the unit grammar refuses
 _ASCII_INT = re.compile(r"[+-]?[0-9]+")
-_ASCII_FLOAT = re.compile(
-    r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?|[+-]?(?:inf|nan)", re.I
-)
 
 
-def _ascii(value: Any, pattern: re.Pattern[str], kind: str, param: Any, ctx: Any) -> None:
-    """Fail unless a text ``value`` is a plain ASCII number of ``pattern``."""
-    if isinstance(value, str) and pattern.fullmatch(value.strip()) is None:
+def _ascii(value: Any, pattern: re.Pattern[str] | None, kind: str, param: Any, ctx: Any) -> None:
+    """Fail unless a text ``value`` is a plain ASCII number.
+
+    ``pattern`` is the integer form; None means a number of the quantity grammar
+    (:func:`microg.units.is_plain_number`).
+    """
+    if not isinstance(value, str):
+        return
+    ok = is_plain_number(value) if pattern is None else pattern.fullmatch(value.strip())
+    if not ok:
         shown = value if len(value) <= 40 else value[:40] + "..."
         raise click.BadParameter(f"expected {kind} in ASCII digits, got {shown!r}", ctx, param)
 
@@ -150,7 +154,7 @@ class PositiveFloat(click.ParamType):
 
     def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
         """The finite float of ``value``, checked against the lower bound."""
-        _ascii(value, _ASCII_FLOAT, "a number", param, ctx)
+        _ascii(value, None, "a number", param, ctx)
         try:
             x = float(value)
         except (TypeError, ValueError):
@@ -179,7 +183,7 @@ class RangeType(click.ParamType):
         parts = str(value).split(":")
         if len(parts) != 3:
             self.fail(f"expected START:STOP:N, got {value!r}", param, ctx)
-        for part, pattern in zip(parts, (_ASCII_FLOAT, _ASCII_FLOAT, _ASCII_INT), strict=True):
+        for part, pattern in zip(parts, (None, None, _ASCII_INT), strict=True):
             _ascii(part, pattern, "START:STOP:N", param, ctx)
         try:
             start, stop = float(parts[0]), float(parts[1])
@@ -211,7 +215,7 @@ class BandType(click.ParamType):
         if len(parts) != 2:
             self.fail(f"expected LO:HI, got {value!r}", param, ctx)
         for part in parts:
-            _ascii(part, _ASCII_FLOAT, "LO:HI numbers", param, ctx)
+            _ascii(part, None, "LO:HI numbers", param, ctx)
         try:
             lo, hi = float(parts[0]), float(parts[1])
         except ValueError:
@@ -252,7 +256,7 @@ class Number(click.FloatRange):
 
     def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
         """The float of ``value``, after the ASCII and finiteness checks, within the range."""
-        _ascii(value, _ASCII_FLOAT, "a number", param, ctx)
+        _ascii(value, None, "a number", param, ctx)
         x = super().convert(value, param, ctx)
         if not math.isfinite(x):
             self.fail(f"expected a finite number, got {value!r}", param, ctx)
