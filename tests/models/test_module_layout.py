@@ -1,9 +1,8 @@
-"""The layout of microg.models and microg.structure: one-way imports, size, public names.
+"""The layout of microg.models and microg.structure: public names and one frame class.
 
-References: the modules' own source, read as syntax trees (every import form: at module
-level, inside functions, relative, and ``from package import submodule``; ``if
-TYPE_CHECKING:`` blocks excepted); the public names of these modules before they were split
-into one concept each, which must still import from the same paths.
+References: the public names of these modules before they were split into one concept each,
+which must still import from the same paths; the modules' own source, read as syntax trees.
+Import cycles and module size are checked for the whole package by tests/test_package_layout.py.
 """
 
 from __future__ import annotations
@@ -15,9 +14,6 @@ from pathlib import Path
 import pytest
 
 SRC = Path(__file__).resolve().parents[2] / "src"
-STAGES = ("microg.models", "microg.structure")
-#: the most lines of one module (docs/architecture.md)
-MAX_LINES = 1000
 
 #: the public names of each module before the split (nastran's CoordSystem excepted: the
 #: one coordinate-system class is microg.models.coords.CoordinateFrame)
@@ -274,80 +270,6 @@ def _modules() -> dict[str, tuple[Path, bool]]:
     return out
 
 
-def _imports(module: str, path: Path, package: bool, known: set[str]) -> set[str]:
-    """Every microg module ``module`` imports, TYPE_CHECKING blocks excepted."""
-    found: set[str] = set()
-    base = module if package else module.rsplit(".", 1)[0]
-
-    def visit(node: ast.AST) -> None:
-        if isinstance(node, ast.If) and "TYPE_CHECKING" in ast.unparse(node.test):
-            for sub in node.orelse:
-                visit(sub)
-            return
-        if isinstance(node, ast.Import):
-            found.update(a.name for a in node.names)
-        elif isinstance(node, ast.ImportFrom):
-            if node.level:
-                parts = base.split(".")
-                target = ".".join(parts[: len(parts) - node.level + 1] + [node.module or ""])
-                target = target.rstrip(".")
-            else:
-                target = node.module or ""
-            for a in node.names:  # from package import submodule: the submodule
-                sub = f"{target}.{a.name}"
-                found.add(sub if sub in known else target)
-        for child in ast.iter_child_nodes(node):
-            visit(child)
-
-    visit(ast.parse(path.read_text(encoding="utf-8")))
-    return {m for m in found if m in known and m != module}
-
-
-def test_no_import_cycle_through_any_import_form():
-    mods = _modules()
-    known = set(mods)
-    graph = {m: _imports(m, p, pkg, known) for m, (p, pkg) in mods.items() if m.startswith(STAGES)}
-    state: dict[str, int] = {}
-    cycle: list[str] = []
-
-    def dfs(node: str, path: list[str]) -> bool:
-        state[node] = 1
-        for nxt in sorted(graph.get(node, ())):
-            if state.get(nxt) == 1:
-                cycle.extend([*path, node, nxt])
-                return True
-            if state.get(nxt) is None and dfs(nxt, [*path, node]):
-                return True
-        state[node] = 2
-        return False
-
-    for node in sorted(graph):
-        if state.get(node) is None and dfs(node, []):
-            break
-    assert cycle == [], " -> ".join(cycle)
-
-
-def test_the_detector_sees_function_level_and_package_imports(tmp_path):
-    # a cycle made only of the forms the package-wide layout test does not resolve: a
-    # function-level "from microg.models import b" and a relative import
-    pkg = tmp_path / "microg" / "models"
-    pkg.mkdir(parents=True)
-    (pkg / "__init__.py").write_text("")
-    (pkg / "a.py").write_text("def f():\n    from microg.models import b\n")
-    (pkg / "b.py").write_text("from .a import f\n")
-    known = {"microg.models", "microg.models.a", "microg.models.b"}
-    assert _imports("microg.models.a", pkg / "a.py", False, known) == {"microg.models.b"}
-    assert _imports("microg.models.b", pkg / "b.py", False, known) == {"microg.models.a"}
-
-
-def test_no_module_over_the_line_limit():
-    long = {
-        m: n
-        for m, (p, _) in _modules().items()
-        if m.startswith(STAGES)
-        and (n := len(p.read_text(encoding="utf-8").splitlines())) > MAX_LINES
-    }
-    assert long == {}
 
 
 @pytest.mark.parametrize("module", sorted(PUBLIC_NAMES))
