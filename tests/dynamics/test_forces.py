@@ -386,3 +386,31 @@ def test_csv_blank_and_comment_lines_anywhere(tmp_path, gap):
     p = write(tmp_path, f"time [s],force [N]\n{gap}0,0\n{gap}1,2\n {gap}2,0\n")
     h = from_csv(p)
     assert np.array_equal(h.timepts, [0, 1, 2]) and np.array_equal(h.force, [0, 2, 0])
+
+
+def test_breakpoints_leave_out_rows_inside_a_constant_piece():
+    # a push, a long run of zeros (sampled rows), a jump and a hold: only the rows inside the
+    # runs of equal values go; the jump at t = 5 (a repeated time) and both ends stay
+    t = np.r_[0.0, 0.5, 1.0, np.linspace(1.1, 5.0, 40), 5.0, 5.5, 6.0, 7.0]
+    f = np.r_[0.0, 20.0, 0.0, np.zeros(40), 3.0, 3.0, 3.0, 3.0]
+    h = ForceHistory(t, f)
+    tb, fb = h.breakpoints
+    np.testing.assert_array_equal(tb, [0.0, 0.5, 1.0, 5.0, 5.0, 7.0])
+    np.testing.assert_array_equal(fb, [0.0, 20.0, 0.0, 0.0, 3.0, 3.0])
+    # the same function everywhere, bit for bit on a dense grid: each piece that remains is
+    # the same line through the same two end values
+    u = np.linspace(-1.0, 8.0, 9001)
+    np.testing.assert_array_equal(ForceHistory(tb, fb).at(u), h.at(u))
+    # nothing to leave out: the arrays themselves
+    g = crew_pushoff(REPORT_F0_N, 1.0, 5.0, 6.0)
+    assert g.breakpoints[0] is g.timepts
+
+
+def test_breakpoints_of_a_vector_history_need_every_component_equal():
+    t = np.arange(5.0)
+    v = np.array([[0.0, 1.0, 1.0, 1.0, 0.0], [0.0, 0.0, 0.0, 2.0, 2.0], [0.0, 0.0, 0.0, 0.0, 0.0]])
+    h = ForceHistory.from_vectors(t, v)
+    tb, vb = h.breakpoints
+    # x is constant over t = 1..3 but y changes at 2..3: every row stays
+    np.testing.assert_array_equal(tb, t)
+    np.testing.assert_array_equal(vb, v)

@@ -96,3 +96,25 @@ def test_modal_accelerations_at_the_peaks_give_back_each_peak():
         # (the value just after the drop differs by the drop's 200 N through the modes);
         # the peak's own evaluation path differs: rounding, 1e-12 relative
         assert np.linalg.norm(a) == pytest.approx(pk.peak_accel_mps2, rel=1e-12)
+
+
+def test_rows_that_repeat_a_value_change_neither_the_answer_nor_the_segments():
+    # the same push written once with its 3 breakpoints and once as 20,001 sampled rows,
+    # most of them zeros: the response is the same function (rounding, 1e-12 of the largest),
+    # and the kernel sees the same pieces (what makes a million-row file cost what its pieces do)
+    omega, zeta, phi, maps, _, t = _case()
+    b = maps["p1"].T @ np.array([0.3, 0.0, 1.0])
+    short = ForceHistory(np.array([0.0, 0.5, 1.0, 10.0]), np.array([0.0, 40.0, 0.0, 0.0]))
+    rows = np.linspace(0.0, 10.0, 20001)
+    long = ForceHistory(rows, short.at(rows))
+    # kept: the rows of the push (0 <= t <= 1 s, each a new value) and the last row
+    assert long.breakpoints[0].size == np.count_nonzero(rows <= 1.0) + 1
+    ref, _ = _superpose(omega, zeta, phi, maps, [(short, b)], t)
+    got, _ = _superpose(omega, zeta, phi, maps, [(long, b)], t)
+    for name in maps:
+        a_ref, a_got = ref.points[name].acceleration, got.points[name].acceleration
+        np.testing.assert_allclose(a_got, a_ref, rtol=0, atol=1e-12 * np.abs(a_ref).max())
+        # both peaks are certified to rtol 1e-9 of the same supremum
+        assert got.peaks[name].peak_accel_mps2 == pytest.approx(
+            ref.peaks[name].peak_accel_mps2, rel=3e-9
+        )

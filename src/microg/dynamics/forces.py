@@ -24,7 +24,7 @@ import re
 import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from functools import lru_cache
+from functools import cached_property, lru_cache
 from importlib import resources
 from pathlib import Path
 
@@ -166,6 +166,27 @@ class ForceHistory:
     def duration(self) -> float:
         """Time from the first to the last breakpoint, s."""
         return float(self.timepts[-1] - self.timepts[0])
+
+    @cached_property
+    def breakpoints(self) -> tuple[np.ndarray, np.ndarray]:
+        """Breakpoint times (s) and values (N; (3, k) for a vector history) that shape f(t).
+
+        A breakpoint whose value equals both neighbours' lies inside a constant piece; leaving
+        it out changes f(t) nowhere.  The response kernels read these, so their cost grows with
+        the pieces of the force, not with rows that repeat a value (a long record of zeros).
+        """
+        raw = self.vector if self.vector is not None else self.values
+        v = np.atleast_2d(raw)
+        keep = np.ones(self.timepts.size, bool)
+        if keep.size > 2:
+            same = np.all(v[:, 1:] == v[:, :-1], axis=0)
+            keep[1:-1] = ~(same[:-1] & same[1:])
+        if keep.all():
+            return self.timepts, raw
+        t, vals = self.timepts[keep], raw[..., keep]
+        t.setflags(write=False)
+        vals.setflags(write=False)
+        return t, vals
 
     def components(self, direction: np.ndarray | None = None) -> np.ndarray:
         """The force vector at each breakpoint, (3, nb), N, model frame.

@@ -519,7 +519,7 @@ def evaluate(
 
 def _one_sided(force: ForceHistory, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Limits from the left and values (right-continuous) of a force history at times ``u``."""
-    tp, fp = np.asarray(force.timepts, float), np.asarray(force.force, float)
+    tp, fp = force.breakpoints
     right = force.at(u)
     i = np.searchsorted(tp, u, side="left") - 1  # last breakpoint strictly before u
     last = tp.size - 1
@@ -554,7 +554,7 @@ def superposed_force(
     timepts_force : (2 U,) s
     modal_force : (m, 2 U) modal force p_j per unit modal mass, m/s^2 per unit coordinate
     """
-    u = np.unique(np.concatenate([np.asarray(f.timepts, float) for f, _ in loads]))
+    u = np.unique(np.concatenate([f.breakpoints[0] for f, _ in loads]))
     pf = np.zeros((np.shape(loads[0][1])[0], 2 * u.size))
     for force, gamma in loads:
         left, right = _one_sided(force, u)

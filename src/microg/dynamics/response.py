@@ -369,8 +369,7 @@ def response_at_points(
     omega = np.asarray(omega, dtype=float)
     b = np.asarray(force_dof_vector, dtype=float)
     _check_phi(phi, omega, b, "response_at_points")
-    timepts_force = np.asarray(force_history.timepts, dtype=float)
-    force = np.asarray(force_history.force, dtype=float)
+    timepts_force, force = force_history.breakpoints
     gamma = phi.T @ b  # (m,) modal participation per newton
     omega, zeta_a, timepts_force, modal_force, timepts_out = check_inputs(
         omega, zeta, timepts_force, np.outer(gamma, force), timepts_out

@@ -125,7 +125,8 @@ def superpose(
     """
     t = timepts_out
     states = [
-        prepare(omega, zeta, ld.force.timepts, np.outer(ld.gamma, ld.force.values)) for ld in loads
+        prepare(omega, zeta, ld.force.breakpoints[0], np.outer(ld.gamma, ld.force.breakpoints[1]))
+        for ld in loads
     ]
     acc = _summed(states, t, (2,))[0]
     # displacements and velocities at the points only (the modal ones are never stored)

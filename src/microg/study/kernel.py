@@ -540,8 +540,7 @@ def _segment_bounds(
     from :func:`~microg.dynamics.response.modal_pwl_response`.  These are the bounds with which
     :func:`~microg.dynamics.response.peak_response` certifies its search.
     """
-    tb = np.asarray(force.timepts, float)
-    fb = np.asarray(force.force, float)
+    tb, fb = force.breakpoints
     starts = np.unique(tb)
     m = group.omega.size
     r = modal_pwl_response(group.omega, group.zeta, tb, np.outer(np.ones(m), fb), starts)
