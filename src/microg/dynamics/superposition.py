@@ -132,9 +132,13 @@ def superpose(
     # displacements and velocities at the points only (the modal ones are never stored)
     d_all, v_all = _summed(states, t, (0, 1), rows)
     a_all = rows @ acc
-    tb, pf = superposed_force([(ld.force, ld.gamma) for ld in loads])
+    if len(loads) == 1:
+        summed = states[0]  # one load: its own states are those of the sum
+    else:
+        tb, pf = superposed_force([(ld.force, ld.gamma) for ld in loads])
+        summed = prepare(omega, zeta, tb, pf)
     peaks = certified_peaks(
-        prepare(omega, zeta, tb, pf),
+        summed,
         list(names),
         rows,
         t,
