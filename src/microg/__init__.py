@@ -109,17 +109,8 @@ def load_model(path: Any, **options: Any) -> Any:
         Reader options: ``units`` (``"in, lbf, s"``; NASTRAN files declare none), ``wtmass``,
         ``points`` (a TOML points file naming grids).
     """
-    try:
-        from microg.models.load import load_model as _load
-    except ImportError:
-        if options:
-            raise InputError(
-                f"reader options {sorted(options)} need the interop readers",
-                where="load_model",
-            ) from None
-        from microg.models.toml import load_station
+    from microg.models.load import load_model as _load
 
-        return load_station(path)
     return _load(path, **options)
 
 
@@ -153,12 +144,17 @@ def solve_modes(
     -------
     Modes
     """
+    import os
+
+    from microg import _args
     from microg.dynamics.modes import solve_modes as _solve
     from microg.structure.discretize import discretize
     from microg.structure.structure import Structure
 
-    if isinstance(model, str):
+    if isinstance(model, str | os.PathLike):
         model = load_model(model)
+    if n_modes is not None:
+        n_modes = _args.integer(n_modes, "n_modes", lo=1)
     structure = (
         model
         if isinstance(model, Structure)

@@ -8,6 +8,7 @@ Each helper raises :class:`~microg.errors.InputError` naming the parameter.
 
 from __future__ import annotations
 
+import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -84,6 +85,12 @@ def direction_list(value: Any) -> list[Any]:
         return []
     if isinstance(value, str | np.ndarray):
         return [value]
+    if not isinstance(value, list | tuple):
+        raise InputError(
+            f"must be a direction ('x', '-z', '1 0 0' or 3 numbers) or a list of them, "
+            f"got {type(value).__name__}",
+            where="direction",
+        )
     items = list(value)
     if len(items) == 3 and all(
         isinstance(c, int | float | np.integer | np.floating) for c in items
@@ -141,10 +148,17 @@ def check_points(names: Sequence[str], known: Sequence[str], where: str) -> None
 
 def model_object(model: Any) -> Any:
     """A model object, or the model a path or shipped name loads."""
-    if isinstance(model, str | Path):
+    if isinstance(model, str | os.PathLike):
         from microg.models.load import load_model
 
-        return load_model(model)
+        return load_model(os.fspath(model))
+    kind = type(model).__name__
+    if kind not in ("Station", "GraphModel", "ModalModel"):
+        raise InputError(
+            f"must be a Station, a modal model, a model file path or a shipped model name, "
+            f"got {kind}",
+            where="model",
+        )
     return model
 
 
@@ -152,10 +166,16 @@ def source_catalogue(sources: Any) -> Any:
     """A source catalogue from a path, ``"example"`` or a catalogue object (None: none)."""
     if sources is None:
         return None
-    if isinstance(sources, str | Path):
-        from microg.environment.sources import load_sources
+    from microg.environment.sources import SourceCatalogue, load_sources
 
-        return load_sources(sources)
+    if isinstance(sources, str | os.PathLike):
+        return load_sources(os.fspath(sources))
+    if not isinstance(sources, SourceCatalogue):
+        raise InputError(
+            f"must be a source catalogue file, 'example' or a SourceCatalogue, "
+            f"got {type(sources).__name__}",
+            where="sources",
+        )
     return sources
 
 

@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 
+from microg import _args
 from microg._vectors import parse_direction
 from microg.analysis.inputs import (
     as_list,
@@ -130,6 +131,19 @@ def analyze(
     system.  Errors name the parameter (``duration``, ``observe``, ``force[1]``...).
     """
     mdl = model_object(model)
+    for name, flag in (("isolation", isolation), ("gravity_gradient", gravity_gradient)):
+        _args.boolean(flag, name)
+    n = None if n is None else _args.integer(n, "n", lo=1)
+    n_modes = None if n_modes is None else _args.integer(n_modes, "n_modes", lo=1)
+    damping = _args.number(damping, "damping", lo=0.0, hi=1.0)  # < 1: _check_options
+    if absorber_mu is not None:
+        absorber_mu = _args.number(absorber_mu, "absorber_mu", lo=0.0, lo_open=True)
+    if progress is not None:
+        _args.function(progress, "progress")
+    if command is not None:
+        _args.text(command, "command")
+    _args.text(method, "method")
+    _args.text(plane, "plane")
     units = getattr(mdl, "unit_system", None)
     catalogue = source_catalogue(sources)
     forces = [] if (catalogue is not None and force is None) else force_histories(force, units)
@@ -163,8 +177,6 @@ def analyze(
         w = "direction" if len(dirs) == 1 else f"direction[{i}]"
         d = parse_direction(dirs[i if len(dirs) == nf else 0], w)
         dists.append(Disturbance(f, at_list[i if len(at_list) == nf else 0], d))
-    if not isinstance(damping, int | float):  # its range: _check_options, with the others
-        raise InputError(f"must be 0 <= zeta < 1, got {damping!r}", where="damping")
     pm = (
         DEFAULTS["package_mass_kg"]
         if package_mass is None
@@ -172,8 +184,6 @@ def analyze(
     )
     if not pm > 0:
         raise InputError(f"must be > 0, got {package_mass!r}", where="package_mass")
-    if absorber_mu is not None and not (np.isfinite(absorber_mu) and absorber_mu > 0):
-        raise InputError(f"must be > 0, got {absorber_mu!r}", where="absorber_mu")
     opts = AnalysisOptions(
         disturbances=dists,
         observe=obs,

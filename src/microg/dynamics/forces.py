@@ -59,10 +59,16 @@ MAX_CSV_LINE = 4096
 MAX_SPEC = 4096
 
 
-def _readonly(a: np.ndarray) -> np.ndarray:
-    a = np.array(a, dtype=float)
-    a.setflags(write=False)
-    return a
+def _readonly(a: np.ndarray, where: str) -> np.ndarray:
+    """A read-only float copy of an array of numbers (InputError naming ``where`` otherwise)."""
+    if isinstance(a, str | bytes) or a is None:
+        raise InputError(f"must be an array of numbers, got {type(a).__name__}", where=where)
+    try:
+        out = np.array(a, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError("must be an array of numbers", where=where) from None
+    out.setflags(write=False)
+    return out
 
 
 def _first(mask: np.ndarray) -> int:
@@ -118,22 +124,22 @@ class ForceHistory:
 
     def __post_init__(self) -> None:
         where = f"force {self.name!r}"
-        t = _readonly(self.timepts)
+        t = _readonly(self.timepts, f"{where}: timepts")
         if t.ndim != 1 or t.size < 1:
             raise InputError("timepts must be a 1-D array of length >= 1", where=where)
         if self.vector is not None:
             if self.force is not None or self.direction is not None:
                 raise InputError("give either force (and direction) or vector", where=where)
-            v = _readonly(self.vector)
+            v = _readonly(self.vector, f"{where}: vector")
             if v.shape != (3, t.size):
                 raise InputError(f"vector must have shape (3, {t.size})", where=where)
             _check_magnitudes(t, v, where)
             object.__setattr__(self, "vector", v)
-            object.__setattr__(self, "force", _readonly(np.sqrt(np.sum(v * v, axis=0))))
+            object.__setattr__(self, "force", _readonly(np.sqrt(np.sum(v * v, axis=0)), where))
         else:
             if self.force is None:
                 raise InputError("give force (N) or vector (3, nb)", where=where)
-            f = _readonly(self.force)
+            f = _readonly(self.force, f"{where}: force")
             if f.shape != t.shape:
                 raise InputError(
                     "timepts and force must be 1-D arrays of equal length >= 1", where=where
@@ -149,7 +155,7 @@ class ForceHistory:
         object.__setattr__(self, "timepts", t)
         if self.direction is not None:
             d = parse_direction(np.asarray(self.direction, dtype=float), f"{where}: direction")
-            object.__setattr__(self, "direction", _readonly(d))
+            object.__setattr__(self, "direction", _readonly(d, f"{where}: direction"))
 
     @property
     def values(self) -> np.ndarray:

@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from microg import _args
 from microg.errors import InputError
 
 if TYPE_CHECKING:
@@ -98,7 +99,7 @@ def load_model(
     -------
     ModalModel or Station
     """
-    p = Path(path)
+    p = _args.path(path, "path")
     suffix = p.suffix.lower()
     label = str(path)
     if loads_station(path, points):

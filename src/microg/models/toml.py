@@ -27,6 +27,7 @@ from pathlib import Path
 import numpy as np
 from pydantic import ValidationError
 
+from microg import _args
 from microg._io import loads_toml
 from microg.errors import ModelError
 from microg.models.build import build_station
@@ -192,6 +193,7 @@ def load_station(path_or_name: str | Path) -> Station:
     ModelError
         Unknown name or unreadable file, or an invalid model (one line naming file and field).
     """
+    _args.path(path_or_name, "path_or_name")
     if isinstance(path_or_name, str):
         shipped = shipped_model_text(path_or_name)
         if shipped is not None:

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from microg import _args
 from microg.errors import InputError
 from microg.structure.structure import Structure
 
@@ -70,6 +71,16 @@ def discretize(
     Structure
     """
     kind = type(model).__name__
+    if kind not in ("ModalModel", "GraphModel", "Station") and not isinstance(model, Structure):
+        raise InputError(
+            f"must be a Station, a frame (graph) model, a modal model or a Structure, got {kind}",
+            where="model",
+            fix="load a file with microg.load_model(path)",
+        )
+    _args.boolean(gravity_gradient, "gravity_gradient")
+    _args.boolean(constrained, "constrained")
+    if n is not None:
+        n = _args.integer(n, "n", lo=1)
     if kind == "ModalModel":
         from microg.structure.modal import modal_structure
 

@@ -38,6 +38,7 @@ from pathlib import Path
 
 from pydantic import ValidationError
 
+from microg import _args
 from microg._io import loads_toml
 from microg.errors import InputError
 from microg.models.messages import structure_error
@@ -101,7 +102,7 @@ def load_study(path: str | Path) -> Study:
     InputError
         One line naming the file and the field.
     """
-    p = Path(path)
+    p = _args.path(path, "path")
     label = str(path)
     try:
         with p.open("rb") as fh:

@@ -31,6 +31,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from microg import _args
 from microg._io import sigterm_raises
 from microg.errors import InputError, MicrogError
 from microg.study.cases import Block, Study, default_n_modes
@@ -618,13 +619,20 @@ def sweep(
         resume).
     """
     if not isinstance(study, Study):
-        study = load_study(study)
+        study = load_study(_args.path(study, "study"))
+    if out is not None:
+        out = _args.path(out, "out")
     if workers is not None and scheduler is not None:
         raise InputError("give workers or scheduler, not both", where="workers")
-    if workers is not None and not (isinstance(workers, int) and 1 <= workers <= 1024):
-        raise InputError(f"must be an integer from 1 to 1024, got {workers!r}", where="workers")
-    if not (np.isfinite(timeout_s) and timeout_s > 0):
-        raise InputError(f"must be > 0, got {timeout_s!r}", where="timeout")
+    if workers is not None:
+        workers = _args.integer(workers, "workers", lo=1, hi=1024)
+    if scheduler is not None:
+        _args.text(scheduler, "scheduler")
+    timeout_s = _args.number(timeout_s, "timeout_s", lo=0.0, lo_open=True, unit="s")
+    threads = _args.integer(threads, "threads", lo=1, hi=1024)
+    _args.boolean(restart, "restart")
+    if progress is not None:
+        _args.function(progress, "progress")
     # what can be checked is checked before the first write (each variant's model, the
     # scheduler's answer); what only a variant's modal solve finds (a mechanism, a record too
     # coarse for the modes) removes again what this call wrote into a new or empty directory
