@@ -229,3 +229,20 @@ def test_bad_uff58_input(tmp_path: Path, capsys) -> None:
     cut.write_text(text[: text.rindex("    -1\n    58")])  # the z record missing
     err = _bad(tmp_path, capsys, [str(cut)], "dataset 58 #1")
     assert "has no z axis" in err
+
+
+def test_a_record_beyond_the_physical_limit_is_refused_with_its_value(tmp_path, capsys) -> None:
+    # 1e300 micro-g (a unit or file error): the band powers would overflow to a verdict of
+    # nulls and "inf"; it is one line naming the file, the sample and its value, exit 2, and
+    # nothing is written
+    path = tmp_path / "huge.csv"
+    t = np.arange(0.0, 20.0, 0.02)
+    a = 1e300 * np.sin(2 * np.pi * t)
+    rows = "\n".join(f"{ti:.6g},{x:.6g},{x:.6g},{x:.6g}" for ti, x in zip(t, a, strict=True))
+    path.write_text("time [s], x [ug], y [ug], z [ug]\n" + rows + "\n")
+    out_dir = tmp_path / "out"
+    rc, out, err = _run(capsys, ["assess", str(path), "--json", "--out", str(out_dir)])
+    assert rc == 2 and out == ""
+    assert len(err.strip().splitlines()) == 1
+    assert "beyond the physical limit" in err and "sample 1 of axis x" in err
+    assert not out_dir.exists()

@@ -51,6 +51,17 @@ def test_contract_keys_and_json(example):
     assert any("ILLUSTRATIVE" in w for w in example.warnings)
 
 
+def test_a_band_without_power_has_the_documented_infinite_margin(example):
+    # docs/assessment.md: an infinite margin (a band with no power) is the string "inf" in
+    # JSON; null means "not computed".  The example's sources leave the lowest bands empty.
+    worst = example.margin[0].min(axis=0)
+    empty = np.isinf(worst)
+    assert empty.any()
+    margin = example.to_dict()["lab"]["third_octave"]["margin"]
+    assert all(m == "inf" for m, e in zip(margin, empty, strict=True) if e)
+    assert all(isinstance(m, float) for m, e in zip(margin, empty, strict=True) if not e)
+
+
 def test_bands_and_limits_come_from_the_requirement(example):
     req = iss_requirement()
     assert np.array_equal(example.center_hz, req.bands.center_hz)

@@ -61,6 +61,7 @@ from typing import Any
 
 import numpy as np
 
+from microg._json import finite_list
 from microg._vectors import AXIS_NAMES, parse_direction
 from microg.dynamics.bandquad import MAX_REFINEMENTS, BandQuadrature, band_quadrature
 from microg.dynamics.bands import MAX_LINES, BandArrays, band_mean_squares
@@ -170,10 +171,6 @@ def _frequencies(freq_hz: Any, where: str) -> np.ndarray:
     return f
 
 
-def _clean(a: np.ndarray) -> list[Any]:
-    return [float(v) if np.isfinite(v) else None for v in np.ravel(a)]
-
-
 @dataclass(frozen=True)
 class AccelerationFRF:
     """Acceleration FRFs of observed points per newton at one input.
@@ -200,13 +197,13 @@ class AccelerationFRF:
         return {
             "at": self.at,
             "direction": [float(v) for v in self.direction],
-            "freq_hz": _clean(self.freq_hz),
+            "freq_hz": finite_list(self.freq_hz),
             "unit": "(m/s^2)/N",
             "points": {
                 p: {
                     a: {
-                        "magnitude": _clean(np.abs(self.accel_per_n[i, k])),
-                        "phase_rad": _clean(np.angle(self.accel_per_n[i, k])),
+                        "magnitude": finite_list(np.abs(self.accel_per_n[i, k])),
+                        "phase_rad": finite_list(np.angle(self.accel_per_n[i, k])),
                     }
                     for k, a in enumerate(self.axes)
                 }
@@ -303,12 +300,12 @@ class HarmonicResponse:
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready: amplitude and phase per line, point and axis; the RMS."""
         return {
-            "freq_hz": _clean(self.freq_hz),
+            "freq_hz": finite_list(self.freq_hz),
             "points": {
                 p: {
                     a: {
-                        "amplitude_mps2": _clean(np.abs(self.accel_mps2[i, k])),
-                        "phase_rad": _clean(np.angle(self.accel_mps2[i, k])),
+                        "amplitude_mps2": finite_list(np.abs(self.accel_mps2[i, k])),
+                        "phase_rad": finite_list(np.angle(self.accel_mps2[i, k])),
                         "rms_mps2": float(self.rms_mps2[i, k]),
                     }
                     for k, a in enumerate(self.axes)
@@ -428,18 +425,18 @@ class BandResponse:
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready: band RMS per point and axis, sources alone, diagnostics."""
         return {
-            "center_hz": _clean(self.center_hz),
-            "lower_hz": _clean(self.lower_hz),
-            "upper_hz": _clean(self.upper_hz),
+            "center_hz": finite_list(self.center_hz),
+            "lower_hz": finite_list(self.lower_hz),
+            "upper_hz": finite_list(self.upper_hz),
             "unit": "m/s^2 RMS",
             "points": {
                 p: {
                     "rms_mps2_axis": {
-                        a: _clean(self.rms_mps2[i, k]) for k, a in enumerate(self.axes)
+                        a: finite_list(self.rms_mps2[i, k]) for k, a in enumerate(self.axes)
                     },
                     "sources": {
                         s: {
-                            a: _clean(self.source_rms_mps2[i, k, :, j])
+                            a: finite_list(self.source_rms_mps2[i, k, :, j])
                             for k, a in enumerate(self.axes)
                         }
                         for j, s in enumerate(self.sources)

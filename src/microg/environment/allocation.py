@@ -29,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-from microg._json import finite_list
+from microg._json import finite_list, json_numbers
 from microg._vectors import AXIS_NAMES, parse_direction
 from microg.dynamics.frequency import BandForceSpectrum, Load, band_response, damping_ratios
 from microg.dynamics.modes import Modes
@@ -104,7 +104,7 @@ class Allocation:
             "lower_hz": finite_list(self.lower_hz),
             "upper_hz": finite_list(self.upper_hz),
             "limit_g": finite_list(self.limit_g),
-            "allowed_rms_n": finite_list(self.allowed_rms_n),
+            "allowed_rms_n": json_numbers(self.allowed_rms_n),  # "inf": no limit
             "governing_axis": list(self.governing_axis),
             "exceeded": [bool(v) for v in self.exceeded],
             "existing_rms_g_axis": {

@@ -13,7 +13,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from microg.units import G0, parse_quantity
+from microg.errors import InputError
+from microg.units import G0, LIMITS, parse_quantity
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -77,6 +78,21 @@ class MeasuredRecord:
     start: str | None = None
     metadata: dict[str, str] = field(default_factory=dict)
     warnings: tuple[str, ...] = ()
+
+    def __post_init__(self) -> None:
+        # a sample beyond the physical limit (100 g) is a unit or a file error, and its
+        # square overflows the band powers: refuse it with the value, never a verdict of nulls
+        a = np.asarray(self.accel)
+        big = np.abs(a) > LIMITS["acceleration"]
+        if np.any(big):
+            ax, i = np.unravel_index(int(np.argmax(big)), a.shape)
+            raise InputError(
+                f"sample {i} of axis {self.axes[ax] if ax < len(self.axes) else ax} is "
+                f"{a[ax, i]:.3g} m/s^2 ({a[ax, i] / G0:.3g} g), beyond the physical limit of "
+                f"{LIMITS['acceleration']:g} m/s^2",
+                where=self.path,
+                fix="check the file's unit and its data",
+            )
 
     @property
     def duration_s(self) -> float:

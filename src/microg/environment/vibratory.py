@@ -29,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-from microg._json import finite_list, finite_or_none
+from microg._json import finite_list, finite_or_none, json_numbers
 from microg._vectors import AXIS_NAMES
 from microg.dynamics.frequency import BandResponse, band_response, damping_ratios
 from microg.dynamics.modes import Modes
@@ -125,7 +125,7 @@ class VibratoryAssessment:
                 "upper_hz": finite_list(self.upper_hz),
                 "rms_g": finite_list(worst_rms),
                 "limit_g": finite_list(self.limit_g),
-                "margin": finite_list(worst_margin),
+                "margin": json_numbers(worst_margin),  # "inf": a band without power
                 "rms_g_axis": {a: finite_list(rms[j]) for j, a in enumerate(self.axes)},
                 "axis": [self.axes[int(j)] for j in gov],
             },

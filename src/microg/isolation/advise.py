@@ -33,6 +33,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from microg._json import json_number
 from microg.errors import InputError
 from microg.units import IN, LBF
 
@@ -234,7 +235,7 @@ class IsolationAdvice:
                 "peak_stroke_m": self.peak_stroke_m,
                 "worst_band": None
                 if wb is None
-                else {"center_hz": wb.center_hz, "margin": _finite(wb.margin)},
+                else {"center_hz": wb.center_hz, "margin": json_number(wb.margin)},
             }
         return out
 
@@ -250,7 +251,10 @@ def _active_dict(act: ActiveIsolation) -> dict[str, Any]:
             return {"phase_margin_deg": None, "gain_margin_db": None}
         pm = min(m.phase_margin_deg for m in ms)
         gm = min(m.gain_margin_factor for m in ms)
-        return {"phase_margin_deg": _finite(pm), "gain_margin_db": _finite(20 * np.log10(gm))}
+        return {
+            "phase_margin_deg": json_number(pm),
+            "gain_margin_db": json_number(20 * np.log10(gm)),
+        }
 
     tc = full["time_check"] or {}
     return {
@@ -328,10 +332,6 @@ def _active_check(
         f"the {ACTIVE_PRESET.upper()}-class active isolator designed for it does not comply "
         f"either ({why} binds; {facts}): not recommended"
     )
-
-
-def _finite(x: float) -> float | str:
-    return float(x) if np.isfinite(x) else "inf"
 
 
 def advise_isolation(
