@@ -150,6 +150,18 @@ def test_bad_pad_input(tmp_path: Path, capsys) -> None:
     assert path.name in err and "truncated" in err
 
 
+@pytest.mark.parametrize("named", ["/etc/passwd", "../x/data", "sub/data", ".."])
+def test_a_pad_header_naming_a_path_is_refused(tmp_path: Path, capsys, named: str) -> None:
+    # the header is given alone and its GData file names a path: the data are read beside
+    # the header only, so that is one line naming GData.file (it was an internal error)
+    path = _pad(tmp_path)
+    header = path.with_name(path.name + ".header")
+    header.write_text(header.read_text().replace(f'file="{path.name}"', f'file="{named}"'))
+    path.rename(tmp_path / "elsewhere")
+    err = _bad(tmp_path, capsys, [str(header)], "GData.file")
+    assert named not in err
+
+
 def test_bad_csv_input(tmp_path: Path, capsys) -> None:
     p = tmp_path / "nan.csv"
     rows = "\n".join(f"{i / FS},0,0,{'nan' if i == 40 else 0}" for i in range(200))

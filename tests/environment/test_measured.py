@@ -52,8 +52,17 @@ def test_comments_name_sensor_and_cutoff(tmp_path: Path) -> None:
     assert read_measured(p).key == "sensor"
 
 
+def test_an_unknown_column_is_not_quoted(tmp_path: Path) -> None:
+    # a file named by mistake (an environment dump, a password file) must not leak through
+    # the error: the column is named by its position only
+    with pytest.raises(InputError) as e:
+        read_accel_csv(_write(tmp_path / "env.csv", "SECRET_TOKEN=abc123, x [g]"))
+    assert "SECRET" not in str(e.value) and "abc123" not in str(e.value)
+    assert e.value.where.endswith("env.csv: line 1, column 1")
+
+
 def test_errors_name_file_and_line(tmp_path: Path) -> None:
-    with pytest.raises(InputError, match="unknown column") as e:
+    with pytest.raises(InputError, match="not a known column") as e:
         read_accel_csv(_write(tmp_path / "d.csv", "time [s], w [g], y [g]"))
     assert e.value.where.endswith("d.csv: line 1, column 2")
     with pytest.raises(InputError, match="not an acceleration|acceleration"):

@@ -155,8 +155,8 @@ def read_accel_csv(path: str | Path) -> MeasuredRecord:
                 raise InputError(f"axis {ax} given twice", where=where)
             axis_cols[ax] = (j, accel_factor(unit, where))
         else:
-            raise InputError(
-                f"unknown column {cell.strip()!r}",
+            raise InputError(  # never quoted: a file named by mistake must not leak
+                "not a known column",
                 where=where,
                 fix="columns: time, x, y, z, each with its unit, e.g. 'time [s], x [m/s^2]'",
             )

@@ -201,7 +201,15 @@ def read_pad(path: str | Path) -> MeasuredRecord:
         )
     hdr = read_pad_header(hp)
     if not dp.is_file() and hdr.data_file:
-        alt = hp.with_name(hdr.data_file)
+        name = hdr.data_file.strip()
+        if not name or name in (".", "..") or "/" in name or "\\" in name or "\0" in name:
+            # the data is read beside its header only: a path in the header is not followed
+            raise InputError(
+                "the header's GData file names a path, not a file beside the header",
+                where=f"{hp}: GData.file",
+                fix=f"put the data file beside its header as {dp.name}",
+            )
+        alt = hp.with_name(name)
         dp = alt if alt.is_file() else dp
     if not dp.is_file():
         raise InputError(
