@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from microg.dynamics.dense import graded_eigh, solve_dense
+from microg.dynamics.modes import solve_modes
 from microg.errors import InputError
 
 
@@ -49,3 +50,36 @@ def test_unstable_mode_reported_with_growth_rate() -> None:
 def test_tuple_unpacking_still_works_for_stable_problems() -> None:
     omega, phi, rigid = solve_dense(np.eye(2), np.array([[1.0, -1.0], [-1.0, 1.0]]))
     assert rigid.tolist() == [True, False] and omega[1] == pytest.approx(np.sqrt(2.0))
+
+
+def _ioc_with_keel_ei(ei: str):
+    from importlib import resources
+
+    from microg.models.toml import loads_station
+
+    text = resources.files("microg.data").joinpath("ioc.toml").read_text()
+    keel = text.index('name = "keel"')
+    at = text.index("ei = ", keel)
+    end = text.index("\n", at)
+    return loads_station(text[:at] + f'ei = "{ei}"' + text[end:])
+
+
+def test_a_near_rigid_keel_is_refused_with_its_reason_not_an_internal_error():
+    # a keel EI of 1e16 N m^2 (inside the documented EI limit) beside the IOC's 5.4e8: the
+    # coordinates' K_ii / M_ii span 6e15, and 29 low modes could not reach the backward-error
+    # check (a SolverError, "internal error").  It is a modelling limit: one InputError
+    # naming the stiffest coordinate and the way out
+    from microg.structure.fem import build_fem
+
+    with pytest.raises(InputError, match=r"span 6\.3e\+15.*keel:") as e:
+        solve_modes(build_fem(_ioc_with_keel_ei("1e16 N*m^2")))
+    assert "ritz" in e.value.fix
+    # 1e12 N m^2 (spread 6e11) is inside what double precision resolves: solved, every mode
+    # through the backward-error check
+    m = solve_modes(build_fem(_ioc_with_keel_ei("1e12 N*m^2")))
+    assert m.n_rigid == 6 and np.all(np.diff(m.omega) >= 0)
+    # the assumed-modes model of the stiff keel solves too (the fix the message offers)
+    from microg.structure.ritz import build_ritz
+
+    r = solve_modes(build_ritz(_ioc_with_keel_ei("1e16 N*m^2"), None, 2, gravity_gradient=False))
+    assert r.n_rigid == 6
