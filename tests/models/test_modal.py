@@ -157,7 +157,38 @@ def test_noisy_mixed_rigid_modes_are_replaced_exactly(ioc_fe):
 def test_rigid_modes_too_close_to_elastic_are_kept_with_a_warning(ioc_fe):
     s, md, xyz, phi = ioc_fe
     f = md.freq_hz.copy()
-    f[:6] = 0.05  # first elastic is 0.127 Hz: less than 10x apart
+    f[:6] = 0.008  # below the 0.01 Hz limit, but the first elastic is 0.05 Hz: not 10x apart
+    f[6] = 0.05
     _, _, rigid, rep, warn = replace_rigid_modes(f, phi, xyz)
     assert rep is None and not rigid.any()
     assert "not 10x below" in warn[0]
+
+
+def test_rigid_shapes_above_the_frequency_limit_stay_elastic_with_a_warning(ioc_fe):
+    # exact rigid shapes on 200+ grids, but the file says 0.05 Hz: the frequency is the
+    # primary evidence, so they are kept as elastic modes and a warning names the limit
+    s, md, xyz, phi = ioc_fe
+    f = md.freq_hz.copy()
+    f[:6] = 0.05
+    om, _, rigid, rep, warn = replace_rigid_modes(f, phi, xyz)
+    assert rep is None and not rigid.any() and np.all(om[:6] > 0)
+    assert "above the 0.01 Hz limit" in warn[0]
+
+
+def test_rigid_fit_on_two_grids_is_not_trusted_without_a_mass(ioc_fe):
+    # the six rigid modes at 1e-5 Hz, but seen on 2 grids only: a rigid-body fit of 12
+    # numbers with 6 unknowns proves nothing, so without a mass they stay as given; the
+    # exact 6x6 rigid-body mass confirms them.  Reference mass: the FE model's rigid modes
+    # are exact rigid motions R C of all 40 grids, mass-normalised, so M_rr = C^-T C^-1
+    s, md, xyz, phi = ioc_fe
+    f = md.freq_hz.copy()
+    f[:6] = 1e-5
+    sub = phi[[0, 5]]
+    _, _, rigid, rep, warn = replace_rigid_modes(f, sub, xyz[[0, 5]])
+    assert rep is None and not rigid.any() and "cannot confirm" in warn[0]
+    c, *_ = np.linalg.lstsq(rigid_basis_at(xyz).reshape(-1, 6), phi[:, :, :6].reshape(-1, 6))
+    ci = np.linalg.inv(c)
+    mrr = ci.T @ ci
+    om, _, rigid, rep, _ = replace_rigid_modes(f, sub, xyz[[0, 5]], rigid_mass=mrr)
+    assert rep.count == 6 and "confirmed by the rigid-body mass" in rep.rule
+    assert np.all(om[:6] == 0.0)

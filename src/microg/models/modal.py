@@ -58,7 +58,9 @@ from microg._io import loads_toml
 from microg.errors import InputError, ModelError
 from microg.models.file_units import SI_UNITS, UnitSystem, check_positive, parse_units
 from microg.models.rigid_modes import (
+    MIN_RIGID_GRIDS,
     RIGID_GAP,
+    RIGID_MAX_HZ,
     RIGID_TOL,
     ReplacedRigid,
     replace_rigid_modes,
@@ -76,6 +78,8 @@ __all__ = [
     "SI_UNITS",
     "MAX_GRIDS",
     "MAX_MODES",
+    "MIN_RIGID_GRIDS",
+    "RIGID_MAX_HZ",
     "ModalModel",
     "ModalPoint",
     "ModelOptions",
@@ -441,16 +445,19 @@ def build_modal_model(
     replace_rigid: bool = True,
     warnings: Sequence[str] = (),
     meta: Mapping[str, Any] | None = None,
+    dof_axes: np.ndarray | None = None,
 ) -> ModalModel:
     """Assemble a :class:`ModalModel` from SI data, replacing free-free rigid modes.
 
     Parameters are those of :class:`ModalModel` (SI, mass-normalised ``phi`` in the basic
-    frame, grids in any order) plus the signed file frequencies and the optional mass
-    sources of :func:`replace_rigid_modes`.
+    frame, grids in any order) plus the signed file frequencies, the optional mass
+    sources and the grids' output systems ``dof_axes`` (g, 3, 3) of
+    :func:`replace_rigid_modes`.
     """
     ids = np.asarray(grid_ids, dtype=np.int64)
     order = np.argsort(ids, kind="stable")
     ids, xyz, phi = ids[order], np.asarray(xyz_m, float)[order], np.asarray(phi, float)[order]
+    axes = None if dof_axes is None else np.asarray(dof_axes, float)[order]
     if ids.size and np.any(np.diff(ids) == 0):
         dup = int(ids[np.flatnonzero(np.diff(ids) == 0)[0]])
         raise ModelError(f"grid {dup} appears twice", where=source)
@@ -472,6 +479,8 @@ def build_modal_model(
             rigid_mass_ref_m=rigid_mass_ref_m,
             mass_matrix=mass_matrix,
             mass_source=mass_source,
+            grid_ids=ids,
+            dof_axes=axes,
         )
         mode_order = np.argsort(np.abs(f), kind="stable")
         gm, z = gm[mode_order], (None if z is None else z[mode_order])
@@ -611,6 +620,9 @@ def load_modal_model(path: str | Path, *, points: Sequence[ModalPoint] = ()) -> 
             max_rigid_residual=float(rr.get("max_rigid_residual", 0.0)),
             first_elastic_hz=rr.get("first_elastic_hz"),
             mass_source=str(rr.get("mass_source", "")),
+            rule=str(rr.get("rule", "")),
+            fit_grids=int(rr.get("fit_grids", 0)),
+            excluded_grids=tuple(int(v) for v in rr.get("excluded_grids", ())),
         )
     u = meta.get("units") or {}
     units = UnitSystem(

@@ -95,6 +95,7 @@ def modal_model_from_op2(
             cd = cd_bdf
     data = Op2Modes(**{**op2.__dict__, "xyz_basic": xyz, "cd": cd, "coords": coords})
     shapes = data.shapes_basic()
+    axes = data.output_axes()
     gm = op2.generalized_mass.astype(float)
     if np.any(gm <= 0) or not np.all(np.isfinite(gm)):
         raise InputError("LAMA has a non-positive generalized mass", where=where)
@@ -141,6 +142,7 @@ def modal_model_from_op2(
         replace_rigid=replace_rigid,
         warnings=warnings,
         meta={"table": op2.table, "sort": op2.sort, "reader": "microg OP2"},
+        dof_axes=axes,
     )
 
 

@@ -240,6 +240,20 @@ class Op2Modes:
         lam = self.eigenvalue
         return np.sign(lam) * np.sqrt(np.abs(lam)) / (2.0 * np.pi)
 
+    def output_axes(self) -> np.ndarray:
+        """Each grid's output system at the grid: columns its axes in basic, (g, 3, 3)."""
+        out = np.broadcast_to(np.eye(3), (self.grid_ids.size, 3, 3)).copy()
+        for cid in np.unique(self.cd):
+            if cid == 0:
+                continue
+            sel = np.flatnonzero(self.cd == cid)
+            cs = self.coords.get(int(cid))
+            if cs is None or self.xyz_basic is None:
+                self.shapes_basic()  # the error naming what is missing
+                continue
+            out[sel] = np.swapaxes(cs.axes_at(self.xyz_basic[sel]), -1, -2)
+        return out
+
     def shapes_basic(self) -> np.ndarray:
         """Eigenvectors rotated from each grid's output system to basic, (g, 6, m)."""
         out = np.array(self.shapes, dtype=float)
