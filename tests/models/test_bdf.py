@@ -411,3 +411,14 @@ def test_reader_agrees_with_pynastran(tmp_path):
                     checked += 1
     # positions, masses and section values were compared (not a vacuous loop)
     assert checked >= 20
+
+
+def test_declared_wtmass_one_contradicting_the_deck_is_an_error(tmp_path):
+    # a UnitSystem whose wtmass was declared counts as given, 1.0 included (load_model
+    # passes --wtmass this way); the default (not declared) takes the deck's value
+    from microg.models.file_units import parse_units
+
+    with_wt = _deck(tmp_path, BASE + "PARAM,WTMASS,0.00259\n", "wt.bdf")
+    with pytest.raises(InputError, match="contradicts wtmass = 1"):
+        load_bdf(with_wt, units=parse_units("in, lbf, s", wtmass=1.0))
+    assert load_bdf(with_wt, units=parse_units("in, lbf, s")).meta["wtmass"] == 0.00259

@@ -194,3 +194,26 @@ def test_op2_without_geometry_takes_it_from_the_deck_beside_it(tmp_path):
     # the OP2 reads through it: the rigid-body replacement fits the file's modes there
     model = microg.load_model(dat.with_suffix(".op2"), units="in,lbf,s")
     np.testing.assert_allclose(model.xyz_m, ref * 0.0254, rtol=1e-15, atol=0)
+
+
+@pytest.mark.parametrize(
+    "file, wtmass, message",
+    [
+        # rdop2gpwg_1.op2's PVT0 holds PARAM,WTMASS,0.00259
+        ("rdop2gpwg_1.op2", 1.0, r"WTMASS 1 declared, but the run used PARAM,WTMASS,0.00259"),
+        ("rdop2gpwg_1.op2", 0.5, r"WTMASS 0.5 declared"),
+        ("rdop2gpwg_1.op2", 0, r"must be > 0"),
+        ("rdop2gpwg_1.op2", 1e-300, r"outside 1e-06 to 1000"),
+        # extseout_assemble.op2's PVT0 has PARAMs but no WTMASS: the run used 1
+        ("extseout_assemble.op2", 0.00259, r"the run used no PARAM,WTMASS \(1\)"),
+    ],
+)
+def test_wtmass_contradicting_the_op2_is_an_error(file, wtmass, message):
+    with pytest.raises(InputError, match=message) as exc:
+        load_model(DATA / file, units="in, lbf, s", wtmass=wtmass)
+    assert exc.value.where == "wtmass"
+
+
+def test_wtmass_agreeing_with_the_op2_is_accepted():
+    m = load_model(DATA / "rdop2gpwg_1.op2", units="in, lbf, s", wtmass=0.00259)
+    assert m.units.wtmass == pytest.approx(0.00259, rel=1e-7)  # PVT0 holds a float32

@@ -138,8 +138,10 @@ def test_cla_against_pyyeti():
     cd_rb[np.searchsorted(mine.grid_ids, ids[sel]), comp[sel] - 1, :] = rb[sel]
     # mine: the same rigid motions, rotated from CD to basic, must be basic rigid motions
     rot = type(mine)(**{**mine.__dict__, "shapes": cd_rb}).shapes_basic()
-    R0 = rigid_basis_at(mine.xyz_basic)
-    assert np.allclose(rot, R0, atol=1e-9 * np.abs(R0).max())
+    # SE 101's interior grids have no position in this OP2 (NaN): SE 0's grids are compared
+    placed = ~np.isnan(mine.xyz_basic).any(axis=1)
+    R0 = rigid_basis_at(mine.xyz_basic[placed])
+    assert np.allclose(rot[placed], R0, atol=1e-9 * np.abs(R0).max())
 
 
 def test_cla_against_pynastran():

@@ -123,6 +123,22 @@ IGNORED_CARDS = (
 # --------------------------------------------------------------------------- deck -> graph
 
 
+def _same_card(a: Card, b: Card) -> bool:
+    """Whether two cards say the same.
+
+    Fields equal as parsed values, trailing blanks and zeros aside (a blank GRID CD/PS/SEID
+    or CORD2 coordinate is 0).
+    """
+
+    def norm(c: Card) -> tuple[Any, ...]:
+        f = list(c.fields)
+        while f and (f[-1] is None or f[-1] == "" or (not isinstance(f[-1], str) and f[-1] == 0)):
+            f.pop()
+        return tuple(f)
+
+    return norm(a) == norm(b)
+
+
 class _Deck:
     """Converts cards to a GraphModel (private)."""
 
@@ -153,6 +169,8 @@ class _Deck:
             if c.name in names:
                 i = c.integer(1, f"{what} id")
                 if i in out:
+                    if _same_card(out[i], c):
+                        continue  # an identical repeat (an INCLUDEd file repeating a card)
                     raise c.error(f"duplicate {what} id {i} (also at {out[i].file}:{out[i].line})")
                 out[i] = c
         return out
@@ -775,7 +793,7 @@ class _Deck:
 
 
 def grid_geometry(
-    path: str | Path, ids: np.ndarray
+    path: str | Path, ids: np.ndarray, *, missing_ok: bool = False
 ) -> tuple[np.ndarray, np.ndarray, dict[int, CoordinateFrame]]:
     """Positions of grids in the basic system, their output systems, and the deck's systems.
 
@@ -788,6 +806,8 @@ def grid_geometry(
         The BDF deck beside the OP2.
     ids : ndarray of int
         The grids wanted (the OP2's), in order.
+    missing_ok : bool
+        Give NaN positions (CD 0) for grids the deck lacks, instead of an error.
 
     Returns
     -------
@@ -804,7 +824,7 @@ def grid_geometry(
     frames = deck.frames()
     _, pos, _ = deck.grids(frames)
     missing = [int(g) for g in ids if int(g) not in pos]
-    if missing:
+    if missing and not missing_ok:
         raise InputError(
             f"{len(missing)} grid(s) of the OP2 are not in the deck (first: {missing[0]})",
             where=str(path),
@@ -812,8 +832,9 @@ def grid_geometry(
         )
     cd = {gid: c.integer(6, "CD", 0) for gid, c in deck.by_id(("GRID",), "grid").items()}
     systems = {cid: f for cid, f in frames.items() if cid != 0}
-    xyz = np.array([pos[int(g)] for g in ids], float).reshape(-1, 3)
-    return xyz, np.array([cd[int(g)] for g in ids], int), systems
+    nowhere = np.full(3, np.nan)
+    xyz = np.array([pos.get(int(g), nowhere) for g in ids], float).reshape(-1, 3)
+    return xyz, np.array([cd.get(int(g), 0) for g in ids], int), systems
 
 
 def load_bdf(
@@ -836,7 +857,7 @@ def load_bdf(
     wtmass : float, optional
         Factor from the deck's mass input to FORCE TIME^2/LENGTH (NASTRAN ``PARAM,WTMASS``);
         default the deck's, else 1.  Contradicting the deck's is an error.  (A UnitSystem's
-        ``wtmass`` other than 1 counts as given.)
+        ``wtmass`` counts as given when it was declared, ``wtmass_given``, 1 included.)
     spc : int, optional
         SPC set noted as the model's constraints; default the case control's ``SPC = n``.
     points : sequence of ModalPoint, optional
@@ -851,7 +872,7 @@ def load_bdf(
     """
     if isinstance(units, UnitSystem):
         system = units
-        if wtmass is None and units.wtmass != 1.0:
+        if wtmass is None and units.wtmass_given:
             wtmass = units.wtmass
     elif units is None or not str(units).strip():
         raise InputError(

@@ -17,7 +17,7 @@ import numpy as np
 from microg.errors import InputError
 from microg.units import parse_quantity
 
-__all__ = ["SI_UNITS", "UnitSystem", "check_positive", "parse_units"]
+__all__ = ["SI_UNITS", "UnitSystem", "WTMASS_RANGE", "check_positive", "parse_units"]
 
 
 @dataclass(frozen=True)
@@ -34,6 +34,8 @@ class UnitSystem:
         The consistent mass unit ``F T^2 / L``, kg (the slinch for in, lbf, s).
     wtmass : float
         NASTRAN's PARAM,WTMASS of the run (input mass times WTMASS = consistent mass).
+    wtmass_given : bool
+        Whether the user declared ``wtmass`` (1 is then a declaration, not the default).
     """
 
     text: str
@@ -42,6 +44,7 @@ class UnitSystem:
     time_s: float
     mass_kg: float
     wtmass: float = 1.0
+    wtmass_given: bool = False
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready provenance."""
@@ -52,8 +55,13 @@ class UnitSystem:
             "time_s": self.time_s,
             "mass_kg": self.mass_kg,
             "wtmass": self.wtmass,
+            "wtmass_given": self.wtmass_given,
         }
 
+
+#: accepted NASTRAN WTMASS values: 1e-6 (mg to kg) to 1e3 (a run whose input mass unit is
+#: a thousand of the consistent one); 1/386.09 = 0.00259 and 1/9.80665 = 0.102 lie inside
+WTMASS_RANGE = (1e-6, 1e3)
 
 #: the SI system (UFF files in SI, microg's own files)
 SI_UNITS = UnitSystem("m, N, s", 1.0, 1.0, 1.0, 1.0)
@@ -70,7 +78,7 @@ def parse_units(text: str, *, where: str = "units", wtmass: float | None = None)
     where : str
         Where the declaration came from, for errors.
     wtmass : float, optional
-        NASTRAN WTMASS (dimensionless, > 0; default 1).
+        NASTRAN WTMASS (dimensionless, :data:`WTMASS_RANGE`; default 1, not a declaration).
 
     Returns
     -------
@@ -111,8 +119,17 @@ def parse_units(text: str, *, where: str = "units", wtmass: float | None = None)
                 where=where,
                 fix="drop the mass unit (it is derived) or make it force*time^2/length",
             )
-    w = 1.0 if wtmass is None else check_positive(wtmass, "wtmass")
-    return UnitSystem(text.strip(), length, force, time, mass, w)
+    w = 1.0
+    if wtmass is not None:
+        w = check_positive(wtmass, "wtmass")
+        lo, hi = WTMASS_RANGE
+        if not lo <= w <= hi:
+            raise InputError(
+                f"WTMASS {w:g} is outside {lo:g} to {hi:g}",
+                where="wtmass",
+                fix="give the run's PARAM,WTMASS (e.g. 0.00259 for lbf-s^2/in from lbm)",
+            )
+    return UnitSystem(text.strip(), length, force, time, mass, w, wtmass is not None)
 
 
 def check_positive(value: Any, where: str) -> float:

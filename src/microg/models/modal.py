@@ -359,6 +359,13 @@ class ModalModel:
         i = int(np.searchsorted(self.grid_ids, grid))
         if i < self.grid_ids.size and self.grid_ids[i] == grid:
             return i
+        left_out = self.meta.get("grids_left_out") or {}
+        if str(grid) in left_out:
+            raise InputError(
+                f"grid {grid} {left_out[str(grid)]}",
+                where=where,
+                fix="give the deck with its GRID card (bdf=...), or name another grid",
+            )
         near = ", ".join(f"grid:{v}" for v in nearest_ids(self.grid_ids, grid))
         raise InputError(
             f"grid {grid} is not in {self.source or 'the model'}",
@@ -632,6 +639,7 @@ def load_modal_model(path: str | Path, *, points: Sequence[ModalPoint] = ()) -> 
         float(u.get("time_s", 1.0)),
         float(u.get("mass_kg", 1.0)),
         float(u.get("wtmass", 1.0)),
+        bool(u.get("wtmass_given", False)),
     )
     file_points = tuple(
         ModalPoint(

@@ -41,10 +41,11 @@ def modal_model_from_op2(
     units: UnitSystem,
     *,
     points: Sequence[ModalPoint] = (),
-    bdf: str | Path | None = None,
+    bdf: str | Path | Sequence[str | Path] | None = None,
     rigid_mass: np.ndarray | None = None,
     rigid_mass_ref_m: np.ndarray | None = None,
     replace_rigid: bool = True,
+    subcase: int | None = None,
 ) -> ModalModel:
     """A :class:`ModalModel` (SI, basic frame, mass-normalised) from a SOL 103 OP2.
 
@@ -55,44 +56,91 @@ def modal_model_from_op2(
         The run's units (``parse_units("in, lbf, s", wtmass=...)``).
     points : sequence of ModalPoint
         Named points (each grid must be in the file).
-    bdf : path, optional
-        Deck for the geometry when the OP2 has none (default: ``<stem>.bdf``/``.dat`` beside).
+    bdf : path or sequence of paths, optional
+        Decks for the positions of grids the OP2 does not place (no geometry tables, or the
+        interior grids of an external superelement); default: ``<stem>.bdf``/``.dat`` beside.
+        Grids placed nowhere are left out with a warning, and naming one says why.
     rigid_mass : ndarray (6, 6), optional
         Rigid-body mass, SI, about ``rigid_mass_ref_m`` (default: the OP2's OGPWG, if any).
     replace_rigid : bool
         Replace free-free rigid modes by exact ones
         (:func:`~microg.models.modal.replace_rigid_modes`).
+    subcase : int, optional
+        The subcase to read (required when the file has modes of several).
     """
-    op2 = read_op2_modes(path)
+    op2 = read_op2_modes(path, subcase=subcase)
     where = op2.path
-    wt_file = op2.params.get("WTMASS")
-    if wt_file is not None and units.wtmass != 1.0 and abs(units.wtmass - wt_file) > 1e-6 * wt_file:
-        raise InputError(
-            f"WTMASS {units.wtmass:g} declared, but the run used PARAM,WTMASS,{wt_file:g}",
-            where="wtmass",
-            fix="declare the run's WTMASS or omit it",
-        )
-    wtmass = float(wt_file) if wt_file is not None else units.wtmass
+    wtmass = _run_wtmass(op2, units)
     warnings: list[str] = []
+    if op2.eigenvalue_source != "LAMA":
+        warnings.append(
+            "no LAMA table: eigenvalues from the OUGV1 record headers, generalized masses 1 "
+            "(the vectors taken as mass-normalised, EIGRL NORM=MASS)"
+        )
     xyz, cd = op2.xyz_basic, op2.cd
     coords = dict(op2.coords)
-    if xyz is None:
-        deck = Path(bdf) if bdf is not None else None
-        if deck is None:
-            for suffix in (".bdf", ".dat"):
-                cand = Path(path).with_suffix(suffix)
-                if cand.is_file():
-                    deck = cand
-                    break
-        if deck is None:
+    basic_out = op2.table.startswith("B") or str(op2.params.get("OUGCORD", "")).upper() == "BASIC"
+    unplaced = np.ones(op2.grid_ids.size, bool) if xyz is None else np.isnan(xyz).any(axis=1)
+    if unplaced.any():
+        decks = _decks(path, bdf)
+        if xyz is None and not decks:
             raise InputError(
                 "the OP2 has no grid geometry (no GEOM1 or BGPDT table) and no BDF is beside it",
                 where=where,
                 fix="rerun with PARAM,POST,-1/-2 (geometry written), or put the deck beside it",
             )
-        xyz, cd_bdf, coords = grid_geometry(deck, op2.grid_ids)
-        if not op2.table.startswith("B") and str(op2.params.get("OUGCORD", "")).upper() != "BASIC":
-            cd = cd_bdf
+        xyz = np.full((op2.grid_ids.size, 3), np.nan) if xyz is None else xyz.copy()
+        cd = cd.copy()
+        for deck in decks:
+            if not unplaced.any():
+                break
+            d_xyz, d_cd, d_sys = grid_geometry(deck, op2.grid_ids[unplaced], missing_ok=True)
+            found = ~np.isnan(d_xyz).any(axis=1)
+            rows = np.flatnonzero(unplaced)[found]
+            xyz[rows] = d_xyz[found]
+            if not basic_out:
+                cd[rows] = d_cd[found]
+            for cid, frame in d_sys.items():
+                coords.setdefault(cid, frame)
+            unplaced[rows] = False
+    left_out: dict[str, str] = {}
+    for gid, ses in op2.ambiguous.items():
+        left_out[str(gid)] = (
+            f"is in superelements {', '.join(str(v) for v in ses)} with different positions "
+            "or motions (microg names a grid by its ID alone), so it was left out"
+        )
+    if unplaced.any():
+        se_of = op2.grid_se if op2.grid_se is not None else np.zeros(op2.grid_ids.size, int)
+        by_se: dict[int, list[int]] = {}
+        for gid, se in zip(op2.grid_ids[unplaced], se_of[unplaced], strict=True):
+            by_se.setdefault(int(se), []).append(int(gid))
+            left_out[str(int(gid))] = (
+                f"is in superelement {int(se)}'s displacement table, but neither the OP2 nor a "
+                "deck gives its position, so it was left out"
+            )
+        for se, gids in sorted(by_se.items()):
+            warnings.append(
+                f"{len(gids)} grid(s) of superelement {se} (first: {gids[0]}) have no position in "
+                "the OP2 or a deck: left out (give the superelement's deck, bdf=[...])"
+            )
+        keep = ~unplaced
+        assert xyz is not None  # filled above
+        op2 = Op2Modes(
+            **{
+                **op2.__dict__,
+                "grid_ids": op2.grid_ids[keep],
+                "shapes": op2.shapes[keep],
+                "grid_se": None if op2.grid_se is None else op2.grid_se[keep],
+            }
+        )
+        xyz, cd = xyz[keep], cd[keep]
+    if op2.ambiguous:
+        amb = sorted(op2.ambiguous)
+        warnings.append(
+            f"{len(amb)} grid ID(s) (first: {amb[0]}) are in several superelements with "
+            "different positions or motions: left out"
+        )
+    assert xyz is not None  # from the OP2 or the decks
     data = Op2Modes(**{**op2.__dict__, "xyz_basic": xyz, "cd": cd, "coords": coords})
     shapes = data.shapes_basic()
     axes = data.output_axes()
@@ -119,6 +167,10 @@ def modal_model_from_op2(
     if op2.n_scalar:
         warnings.append(f"{op2.n_scalar} scalar points dropped (no position)")
     for p in points:
+        if str(p.grid) in left_out:
+            raise InputError(
+                f"grid {p.grid} (point {p.name!r}) {left_out[str(p.grid)]}", where=where
+            )
         if p.grid not in set(op2.grid_ids.tolist()):
             near = ", ".join(f"grid:{v}" for v in nearest_ids(op2.grid_ids, p.grid))
             raise InputError(
@@ -132,7 +184,9 @@ def modal_model_from_op2(
         xyz_m=xyz * L,
         freq_hz_signed=freq,
         phi=phi,
-        units=UnitSystem(units.text, units.length_m, units.force_N, units.time_s, M, wtmass),
+        units=UnitSystem(
+            units.text, units.length_m, units.force_N, units.time_s, M, wtmass, units.wtmass_given
+        ),
         source=where,
         generalized_mass_kg_m2=gm * M * L * L,
         points=points,
@@ -141,9 +195,43 @@ def modal_model_from_op2(
         mass_source=src,
         replace_rigid=replace_rigid,
         warnings=warnings,
-        meta={"table": op2.table, "sort": op2.sort, "reader": "microg OP2"},
+        meta={
+            "table": op2.table,
+            "sort": op2.sort,
+            "reader": "microg OP2",
+            "tables": list(op2.tables),
+            "subcase": op2.subcase,
+            "eigenvalues": op2.eigenvalue_source,
+            "grids_left_out": left_out,
+        },
         dof_axes=axes,
     )
+
+
+def _decks(path: str | Path, bdf: str | Path | Sequence[str | Path] | None) -> list[Path]:
+    if bdf is None:
+        return [c for c in (Path(path).with_suffix(x) for x in (".bdf", ".dat")) if c.is_file()][:1]
+    if isinstance(bdf, str | Path):
+        return [Path(bdf)]
+    return [Path(b) for b in bdf]
+
+
+def _run_wtmass(op2: Op2Modes, units: UnitSystem) -> float:
+    """The run's WTMASS: the OP2's PVT0 (absent there: 1, the default), else the declared one.
+
+    A declared WTMASS that contradicts the file is an error (``units.wtmass_given``).
+    """
+    if not op2.params:  # no PVT0: the file does not say
+        return units.wtmass
+    wt_file = float(op2.params.get("WTMASS", 1.0))
+    if units.wtmass_given and abs(units.wtmass - wt_file) > 1e-6 * wt_file:
+        said = "PARAM,WTMASS," + f"{wt_file:g}" if "WTMASS" in op2.params else "no PARAM,WTMASS (1)"
+        raise InputError(
+            f"WTMASS {units.wtmass:g} declared, but the run used {said}",
+            where="wtmass",
+            fix="declare the run's WTMASS or omit it",
+        )
+    return wt_file
 
 
 # --------------------------------------------------------------------------- OP4

@@ -24,6 +24,7 @@ needed here):
 
 from __future__ import annotations
 
+import re
 import struct
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -138,7 +139,7 @@ class Op2File:
                 break
             if k + 8 > len(recs):
                 raise self._fail("a data block header is cut")
-            name = self._bytes(k + 1)[:8].decode("latin1").strip()
+            name = self.name8(self._bytes(k + 1))
             trailer = np.frombuffer(
                 self._bytes(k + 4), self.endian + ("i4" if self.word == 4 else "i8")
             )
@@ -165,6 +166,12 @@ class Op2File:
                 k += 3  # -r, 1, 0
             tables.append((name, trailer, logical))
         return tables
+
+    def name8(self, raw: bytes) -> str:
+        """An 8-character name in two words (a 64-bit word holds 4 characters and 4 blanks)."""
+        if self.word == 8:
+            raw = raw[:4] + raw[8:12]
+        return raw[:8].decode("latin1").replace("\x00", " ").strip()
 
     def ints(self, rec: bytes) -> np.ndarray:
         """Record as integers."""
@@ -205,7 +212,7 @@ class Op2Modes:
     cd : ndarray (g,) int
         Output system of each grid's components (0 when the table is in basic).
     xyz_basic : ndarray (g, 3) or None
-        Grid positions in basic (file length unit).
+        Grid positions in basic (file length unit); NaN for a grid the OP2 does not place.
     coords : dict of int to CoordinateFrame
         Coordinate systems by id, origins in the file's length unit.
     rigid_mass : ndarray (6, 6) or None
@@ -216,6 +223,20 @@ class Op2Modes:
         PARAMs from PVT0.
     n_scalar : int
         Scalar points dropped.
+    superelements : tuple of int
+        The superelements whose displacement tables were read (0: the residual).
+    ambiguous : dict of int to tuple of int
+        Grid IDs that several superelements give with different positions or motions, and
+        those superelements; such grids are left out (a grid is named by its ID alone).
+    eigenvalue_source : str
+        ``"LAMA"``, or ``"OUGV1 headers"`` when the file has no LAMA (generalized masses are
+        then 1: the vectors are taken as mass-normalised, EIGRL's default NORM=MASS).
+    subcase : int
+        The subcase read.
+    tables : tuple of str
+        The displacement tables read, ``"OUGV1 (SE 101)"``.
+    grid_se : ndarray (g,) int
+        The (first) superelement whose table gives each grid.
     """
 
     path: str
@@ -233,6 +254,12 @@ class Op2Modes:
     rigid_mass_ref: np.ndarray | None = None
     params: dict[str, Any] = field(default_factory=dict)
     n_scalar: int = 0
+    superelements: tuple[int, ...] = (0,)
+    ambiguous: dict[int, tuple[int, ...]] = field(default_factory=dict)
+    eigenvalue_source: str = "LAMA"
+    subcase: int = 1
+    tables: tuple[str, ...] = ()
+    grid_se: np.ndarray | None = None
 
     @property
     def freq_hz_signed(self) -> np.ndarray:
@@ -288,8 +315,7 @@ def _pvt0(f: Op2File) -> dict[str, Any]:
         i = 0
         try:
             while i + 3 <= ints.size:
-                name = raw[i * w : (i + 2) * w].decode("latin1")
-                name = name.replace("\x00", " ")[: 8 if w == 4 else 16].strip()
+                name = f.name8(raw[i * w : (i + 2) * w])
                 kind = int(ints[i + 2])
                 i += 3
                 if kind == 1:
@@ -299,7 +325,7 @@ def _pvt0(f: Op2File) -> dict[str, Any]:
                     params[name] = float(flts[i])
                     i += 1
                 elif kind == 3:
-                    params[name] = raw[i * w : (i + 2) * w].decode("latin1").strip()
+                    params[name] = f.name8(raw[i * w : (i + 2) * w])
                     i += 2
                 elif kind == 4:
                     params[name] = (
@@ -339,9 +365,14 @@ def _lama(f: Op2File) -> np.ndarray | None:
 
 def _geometry(
     f: Op2File,
-) -> tuple[dict[int, tuple[int, np.ndarray, int]], dict[int, CoordinateFrame]]:
-    """Grid id -> (cp, x in cp, cd) and the coordinate systems, from GEOM1/GEOM1S."""
+) -> tuple[dict[int, tuple[int, np.ndarray, int]], dict[int, CoordinateFrame], set[int]]:
+    """Grids and coordinate systems from GEOM1/GEOM1S.
+
+    Returns grid id -> (cp, x in cp, cd), the systems, and the grid IDs that several
+    GEOM1/GEOM1S tables (superelements) define differently.
+    """
     grids: dict[int, tuple[int, np.ndarray, int]] = {}
+    clash: set[int] = set()
     cords: dict[int, Cord2] = {}
     kinds = {(2101, 21, 8): "R", (2001, 20, 9): "C", (2201, 22, 10): "S"}
     for _, _, recs in f.named("GEOM1", "GEOM1S"):
@@ -355,9 +386,13 @@ def _geometry(
                 n = body_i.size // 8
                 bi, bf = body_i[: 8 * n].reshape(n, 8), body_f[: 8 * n].reshape(n, 8)
                 for r in range(n):
-                    grids.setdefault(
-                        int(bi[r, 0]), (int(bi[r, 1]), bf[r, 2:5].astype(float), int(bi[r, 5]))
-                    )
+                    gid = int(bi[r, 0])
+                    new = (int(bi[r, 1]), bf[r, 2:5].astype(float), int(bi[r, 5]))
+                    old = grids.setdefault(gid, new)
+                    if old is not new and (
+                        old[0] != new[0] or old[2] != new[2] or not np.array_equal(old[1], new[1])
+                    ):
+                        clash.add(gid)
             elif head in kinds:
                 n = body_i.size // 13
                 bi, bf = body_i[: 13 * n].reshape(n, 13), body_f[: 13 * n].reshape(n, 13)
@@ -381,7 +416,7 @@ def _geometry(
                     fix="use CORD2R/C/S, or output in basic (PARAM,OUGCORD,BASIC)",
                 )
     systems = chain_cord2(list(cords.values()))
-    return grids, systems
+    return grids, systems, clash
 
 
 def _bgpdt(f: Op2File) -> dict[int, tuple[int, np.ndarray]]:
@@ -419,14 +454,33 @@ def _ogpwg(f: Op2File) -> tuple[np.ndarray, int] | None:
     return None
 
 
-def _eigenvector_tables(f: Op2File) -> list[tuple[str, list[bytes]]]:
-    out = []
+@dataclass(frozen=True)
+class _Table:
+    name: str
+    recs: list[bytes]
+    se: int
+    subcase: int
+
+
+def _eigenvector_tables(f: Op2File) -> tuple[list[_Table], list[str]]:
+    """The real-mode displacement tables, and the others of those names, described."""
+    out, other = [], []
     for name, _, recs in f.named("OUGV1", "BOUGV1", "OUGV2", "BOUGV2"):
-        if len(recs) >= 3:
-            ident = f.ints(recs[1])
-            if ident.size >= 10 and ident[0] // 10 == 2 and ident[1] % 1000 == 7:
-                out.append((name, recs))
-    return out
+        ident = f.ints(recs[1]) if len(recs) >= 2 else np.zeros(0, int)
+        if len(recs) >= 3 and ident.size >= 10 and ident[0] // 10 == 2 and ident[1] % 1000 == 7:
+            sub = recs[1][82 * f.word : 114 * f.word]
+            if f.word == 8:
+                sub = b"".join(sub[i : i + 4] for i in range(0, len(sub), 8))
+            m = re.search(rb"SUPERELEMENT\s+(\d+)", sub)
+            out.append(_Table(name, recs, int(m.group(1)) if m else 0, int(ident[3])))
+        elif ident.size >= 2:
+            other.append(
+                f"{name} (approach code {int(ident[0]) // 10}, table code {int(ident[1])}: "
+                "not real modes)"
+            )
+        else:
+            other.append(f"{name} (empty)")
+    return out, other
 
 
 def _read_ougv(
@@ -493,55 +547,137 @@ def _read_ougv(
     )
 
 
-def read_op2_modes(path: str | Path) -> Op2Modes:
+def _merge(
+    parts: list[tuple[_Table, tuple[Any, ...]]], clash: set[int]
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[int, tuple[int, ...]]]:
+    """Grids of every superelement's table: (ids, shapes, in basic, SE, ambiguous ids)."""
+    ids = np.concatenate([r[3] for _, r in parts])
+    shp = np.concatenate([r[4] for _, r in parts], axis=0)
+    se = np.concatenate([np.full(r[3].size, t.se) for t, r in parts])
+    basic = np.concatenate([np.full(r[3].size, t.name.startswith("B")) for t, r in parts])
+    order = np.argsort(ids, kind="stable")
+    ids, shp, se, basic = ids[order], shp[order], se[order], basic[order]
+    uniq, first, counts = np.unique(ids, return_index=True, return_counts=True)
+    bad = np.isin(uniq, np.fromiter(clash, np.int64, len(clash)))
+    ambiguous: dict[int, tuple[int, ...]] = {}
+    for u in np.flatnonzero((counts > 1) | bad):
+        a, n = first[u], counts[u]
+        ref = shp[a]
+        tol = 1e-6 * max(float(np.abs(ref).max()), 1e-30)
+        same = all(
+            basic[a + j] == basic[a] and float(np.abs(shp[a + j] - ref).max()) <= tol
+            for j in range(1, n)
+        )
+        if bad[u] or not same:
+            ambiguous[int(uniq[u])] = tuple(sorted({int(v) for v in se[a : a + n]}))
+    keep = ~np.isin(uniq, np.fromiter(ambiguous, np.int64, len(ambiguous)))
+    k = first[keep]
+    return uniq[keep], shp[k], basic[k], se[k], ambiguous
+
+
+def read_op2_modes(path: str | Path, *, subcase: int | None = None) -> Op2Modes:
     """Read the real modes of a SOL 103 OP2 (see the module docstring).
+
+    Every superelement's displacement table of the subcase is read; a grid several
+    superelements give alike (a boundary grid) is one grid, one they give differently is
+    left out and listed in :attr:`Op2Modes.ambiguous`.  Without LAMA, the eigenvalues come
+    from the OUGV1 record headers and the generalized masses are 1 (mass-normalised
+    vectors); vectors normalised to a unit largest component are then refused.
+
+    Parameters
+    ----------
+    path : str or Path
+    subcase : int, optional
+        The subcase to read (required when the file has modes of several).
 
     Raises
     ------
     InputError
-        Not an OP2, truncated or corrupt, no eigenvectors or no eigenvalue table (one line
-        naming the file).
+        Not an OP2, truncated or corrupt, no eigenvectors or no eigenvalues, an unknown or
+        unchosen subcase (one line naming the file).
     """
     f = Op2File(path)
-    tables = _eigenvector_tables(f)
+    tables, other = _eigenvector_tables(f)
     lama = _lama(f)
     if not tables:
         names = ", ".join(sorted({t[0] for t in f.tables})) or "none"
+        unusable = f"; unusable: {'; '.join(other)}" if other else ""
         raise InputError(
-            f"no real eigenvectors (no OUGV1/BOUGV1 table of SOL 103 modes; data blocks: {names})",
+            "no real eigenvectors (no OUGV1/BOUGV1 table of SOL 103 modes; data blocks: "
+            f"{names}{unusable})",
             where=f.path,
             fix="rerun with DISPLACEMENT(PLOT) = ALL and PARAM,POST,-1 or -2",
         )
-    name, recs = tables[0]
-    sort, modes, eig_id, ids, shapes, n_scalar = _read_ougv(f, name, recs, lama)
-    if lama is None:
+    subs = sorted({t.subcase for t in tables})
+    if subcase is None:
+        if len(subs) > 1:
+            raise InputError(
+                f"the file holds modes of subcases {', '.join(str(v) for v in subs)}",
+                where=f.path,
+                fix="choose one with --subcase N (subcase=N)",
+            )
+        subcase = subs[0]
+    elif subcase not in subs:
         raise InputError(
-            "no LAMA table (eigenvalues and generalized masses)",
+            f"no modes of subcase {subcase} in the file (subcases: "
+            f"{', '.join(str(v) for v in subs)})",
+            where="subcase",
+        )
+    chosen: dict[int, _Table] = {}
+    for t in tables:
+        if t.subcase == subcase:
+            chosen.setdefault(t.se, t)
+    parts = [(t, _read_ougv(f, t.name, t.recs, lama)) for t in chosen.values()]
+    t0, (sort, modes, eig_id, _, _, _) = parts[0]
+    for t, r in parts[1:]:
+        if not np.array_equal(r[1], modes):
+            raise InputError(
+                f"{t.name} of superelement {t.se} holds other modes than {t0.name} of "
+                f"superelement {t0.se}",
+                where=f.path,
+            )
+    if lama is not None:
+        row = {int(mn): r for r, mn in enumerate(lama[:, 0].astype(int))}
+        missing = [int(mn) for mn in modes if int(mn) not in row]
+        if missing:
+            raise InputError(
+                f"{t0.name} mode {missing[0]} has no LAMA entry", where=f.path, fix="check the file"
+            )
+        sel = np.array([row[int(mn)] for mn in modes])
+        eigenvalue, gm, eig_src = lama[sel, 2], lama[sel, 5], "LAMA"
+    elif sort == "SORT1" and np.all(np.isfinite(eig_id)):
+        eigenvalue, gm, eig_src = eig_id, np.ones(modes.size), "OUGV1 headers"
+    else:
+        raise InputError(
+            "no LAMA table (eigenvalues and generalized masses), and SORT2 eigenvectors carry "
+            "no eigenvalues",
             where=f.path,
             fix="rerun SOL 103 with PARAM,POST so that LAMA is written",
         )
-    row = {int(mn): r for r, mn in enumerate(lama[:, 0].astype(int))}
-    missing = [int(mn) for mn in modes if int(mn) not in row]
-    if missing:
-        raise InputError(
-            f"{name} mode {missing[0]} has no LAMA entry", where=f.path, fix="check the file"
-        )
-    sel = np.array([row[int(mn)] for mn in modes])
     params = _pvt0(f)
-    grids, systems = _geometry(f)
+    grids, systems, clash = _geometry(f)
+    ids, shapes, in_basic, grid_se, ambiguous = _merge(parts, clash)
+    n_scalar = sum(int(r[5]) for _, r in parts)
+    if eig_src != "LAMA" and shapes.size:
+        peak = np.abs(shapes).max(axis=(0, 1))
+        if np.all(np.abs(peak - 1.0) <= 1e-6):
+            raise InputError(
+                "no LAMA table, and the eigenvectors are scaled to a unit largest component "
+                "(EIGRL NORM=MAX): their generalized masses are unknown",
+                where=f.path,
+                fix="rerun with PARAM,POST so that LAMA is written, or with NORM=MASS",
+            )
+    name = t0.name
     xyz = None
     cd = np.zeros(ids.size, int)
     if grids:
-        miss = [int(g) for g in ids if int(g) not in grids]
-        if miss:
-            raise InputError(
-                f"grid {miss[0]} of {name} is not in the OP2's GEOM1 table", where=f.path
-            )
-        cps = np.array([grids[int(g)][0] for g in ids])
-        local = np.array([grids[int(g)][1] for g in ids])
-        cd = np.array([grids[int(g)][2] for g in ids])
-        xyz = np.zeros((ids.size, 3))
-        for cp in np.unique(cps):
+        # grids the OP2 does not place (interior grids of an external superelement) are NaN
+        nowhere = (-1, np.full(3, np.nan), 0)
+        cps = np.array([grids.get(int(g), nowhere)[0] for g in ids], int)
+        local = np.array([grids.get(int(g), nowhere)[1] for g in ids], float).reshape(-1, 3)
+        cd = np.array([grids.get(int(g), nowhere)[2] for g in ids], int)
+        xyz = np.full((ids.size, 3), np.nan)
+        for cp in np.unique(cps[cps >= 0]):
             cs = systems.get(int(cp))
             if cs is None:
                 raise InputError(
@@ -554,9 +690,9 @@ def read_op2_modes(path: str | Path) -> Op2Modes:
         if bg and all(int(g) in bg for g in ids):
             cd = np.array([bg[int(g)][0] for g in ids])
             xyz = np.array([bg[int(g)][1] for g in ids])
-    basic_output = name.startswith("B") or str(params.get("OUGCORD", "")).upper() == "BASIC"
-    if basic_output:
-        cd = np.zeros(ids.size, int)
+    if str(params.get("OUGCORD", "")).upper() == "BASIC":
+        in_basic = np.ones(ids.size, bool)
+    cd = np.where(in_basic, 0, cd)
     gp = _ogpwg(f)
     rm = ref = None
     if gp is not None:
@@ -571,8 +707,8 @@ def read_op2_modes(path: str | Path) -> Op2Modes:
         table=name,
         sort=sort,
         mode=modes,
-        eigenvalue=lama[sel, 2],
-        generalized_mass=lama[sel, 5],
+        eigenvalue=np.asarray(eigenvalue, float),
+        generalized_mass=np.asarray(gm, float),
         grid_ids=ids,
         shapes=shapes,
         cd=cd,
@@ -582,4 +718,10 @@ def read_op2_modes(path: str | Path) -> Op2Modes:
         rigid_mass_ref=ref,
         params=params,
         n_scalar=n_scalar,
+        superelements=tuple(sorted(chosen)),
+        ambiguous=ambiguous,
+        eigenvalue_source=eig_src,
+        subcase=int(subcase),
+        tables=tuple(f"{t.name} (SE {t.se})" for t in chosen.values()),
+        grid_se=grid_se,
     )
