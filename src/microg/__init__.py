@@ -107,7 +107,7 @@ def load_model(path: Any, **options: Any) -> Any:
         readers) a NASTRAN ``.op2``/``.op4``/``.bdf``, a UFF ``.unv``, or microg's own modal file.
     **options
         Reader options: ``units`` (``"in, lbf, s"``; NASTRAN files declare none), ``wtmass``,
-        ``points`` (a TOML points file naming grids).
+        ``points`` (a TOML points file naming grids), ``subcase`` (an OP2's subcase).
     """
     from microg.models.load import load_model as _load
 

@@ -217,3 +217,12 @@ def test_wtmass_contradicting_the_op2_is_an_error(file, wtmass, message):
 def test_wtmass_agreeing_with_the_op2_is_accepted():
     m = load_model(DATA / "rdop2gpwg_1.op2", units="in, lbf, s", wtmass=0.00259)
     assert m.units.wtmass == pytest.approx(0.00259, rel=1e-7)  # PVT0 holds a float32
+
+
+def test_subcase_reaches_the_op2_reader_and_only_it(tmp_path):
+    with pytest.raises(InputError, match=r"no modes of subcase 2 in the file \(subcases: 1\)"):
+        load_model(DATA / "cla_residual.op2", units="in, lbf, s", subcase=2)
+    assert load_model(DATA / "cla_residual.op2", units="in, lbf, s", subcase=1).meta["subcase"] == 1
+    with pytest.raises(InputError, match="applies to OP2 files only") as exc:
+        load_model("ioc", subcase=1)
+    assert exc.value.where == "subcase"

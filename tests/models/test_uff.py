@@ -134,3 +134,20 @@ def test_bad_uff_files(tmp_path, model):
     with pytest.raises(InputError, match="no units"):
         modal_model_from_uff(no164)
     assert modal_model_from_uff(no164, units=parse_units("m, N, s")).n_modes == 30
+
+
+@pytest.mark.parametrize(
+    "units, wtmass, message",
+    [
+        ("m, N, ms", None, "declared time unit disagrees with the file's dataset 164"),
+        ("in, lbf, s", None, "declared length unit disagrees"),
+        ("m, N, s", 1.0, "applies to NASTRAN files only"),
+    ],
+)
+def test_declarations_contradicting_a_uff_file_are_errors(model, tmp_path, units, wtmass, message):
+    # the file's dataset 164 states SI (write_uff_modes); UFF has no WTMASS, and 164 has no
+    # time factor (seconds): any other declaration contradicts the file
+
+    f = write_uff_modes(model, tmp_path / "m.unv")
+    with pytest.raises(InputError, match=message):
+        load_model(f, units=units, wtmass=wtmass)

@@ -24,6 +24,7 @@ FLAGS = {
     "units": "--units",
     "wtmass": "--wtmass",
     "points": "--points",
+    "subcase": "--subcase",
     "constrained": "--constrained",
 }
 
@@ -105,6 +106,12 @@ def _effective_percent(m: Any) -> dict[str, Any]:
     help="Also write the modes as UFF datasets 15+55 (+164 units) to this file.",
 )
 @click.option(
+    "--subcase",
+    type=click.IntRange(min=1),
+    default=None,
+    help="An OP2 with modes of several subcases: the subcase to read.",
+)
+@click.option(
     "--constrained",
     is_flag=True,
     help="A NASTRAN deck or frame model: apply its SPCs (the clamped run); default free-free.",
@@ -122,6 +129,7 @@ def modes(
     wtmass: float | None,
     points: Path | None,
     uff_out: Path | None,
+    subcase: int | None,
     constrained: bool,
     as_json: bool,
 ) -> None:
@@ -146,7 +154,7 @@ def modes(
         raise InputError("applies to --method ritz only", where="--functions")
     if uff_out is not None:  # before any work: a file that cannot be written is bad input
         uff_out = check_writable(uff_out, where="--uff", directory=False)
-    given = (("units", units), ("wtmass", wtmass), ("points", points))
+    given = (("units", units), ("wtmass", wtmass), ("points", points), ("subcase", subcase))
     options = {k: v for k, v in given if v is not None}
     with flag_errors(FLAGS):
         mdl = microg.load_model(model, **options)

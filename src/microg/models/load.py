@@ -81,6 +81,7 @@ def load_model(
     units: str | None = None,
     wtmass: float | None = None,
     points: str | Path | None = None,
+    subcase: int | None = None,
 ) -> Any:
     """Read a model of any kind microg knows (see the module docstring).
 
@@ -94,6 +95,8 @@ def load_model(
         NASTRAN PARAM,WTMASS of the run.
     points : str or Path, optional
         Points/options TOML file (named grids, kinds, and optionally ``units``/``wtmass``).
+    subcase : int, optional
+        The subcase of an OP2 with modes of several (an OP2 option only).
 
     Returns
     -------
@@ -102,6 +105,12 @@ def load_model(
     p = _args.path(path, "path")
     suffix = p.suffix.lower()
     label = str(path)
+    if subcase is not None and suffix != ".op2":
+        raise InputError("applies to OP2 files only", where="subcase", fix="leave it out")
+    if subcase is not None and (
+        isinstance(subcase, bool) or not isinstance(subcase, int) or subcase < 1
+    ):
+        raise InputError(f"expected a positive integer, got {subcase!r}", where="subcase")
     if loads_station(path, points):
         # a station (a file or a shipped name): the modal readers are not needed
         from microg.models.toml import load_station
@@ -142,7 +151,7 @@ def load_model(
         from microg.models.nastran import modal_model_from_op2
 
         u = _units(units, wtmass, opts, label, need=True)
-        return modal_model_from_op2(p, u, points=opts.points)
+        return modal_model_from_op2(p, u, points=opts.points, subcase=subcase)
     from microg.models.nastran import modal_model_from_op4
 
     u = _units(units, wtmass, opts, label, need=True)

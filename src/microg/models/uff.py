@@ -232,10 +232,17 @@ def modal_model_from_uff(
             where=where,
             fix='declare the units, e.g. units = "m, N, s"',
         )
+    if units is not None and units.wtmass_given:
+        raise InputError(
+            "applies to NASTRAN files only: a UFF file's masses are in its declared units",
+            where="wtmass",
+            fix="leave it out",
+        )
     if file_units is not None and units is not None:
         for a, b, what in (
             (file_units.length_m, units.length_m, "length"),
             (file_units.force_N, units.force_N, "force"),
+            (file_units.time_s, units.time_s, "time"),
         ):
             if abs(a - b) > 1e-6 * b:
                 raise InputError(
