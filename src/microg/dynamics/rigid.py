@@ -22,6 +22,10 @@ __all__ = ["RIGID_TOL", "rigid_basis", "m_orthonormal", "rowwise_small", "suppor
 #: exact rigid vectors of the frame models score ~1e-16; a restraint softer than 1e-12 of a
 #: row's stiffness cannot be told from rigid (documented limit)
 RIGID_TOL = 1e-12
+#: fraction of a row's largest stiffness times the vector's largest entry below which a
+#: row's K r is round-off (double precision, 2.2e-16, times the few hundred terms a row may
+#: sum); a restraint that soft is below RIGID_TOL's documented limit anyway
+RIGID_FLOOR = 1e-13
 
 
 def rigid_basis(
@@ -55,13 +59,18 @@ def rigid_basis(
         return np.zeros((n, 0))
     c = np.asarray(candidates, float).reshape(n, -1)
     kc = stiffness @ c
-    akc = abs(stiffness) @ np.abs(c)
+    ak = abs(stiffness)
+    akc = ak @ np.abs(c)
+    # the largest stiffness of each row's DOFs: a row whose |K||r| is itself round-off (a
+    # DOF on a rotation's axis) is judged against it, not against its own round-off
+    kmax = np.asarray(ak.max(axis=1).toarray() if hasattr(ak, "toarray") else ak.max(axis=1))
+    kmax = kmax.reshape(-1)
     mcc = c.T @ (mass @ c)
     mcc = 0.5 * (mcc + mcc.T)
     kcc = c.T @ kc
     kcc = 0.5 * (kcc + kcc.T)
     eye = np.eye(c.shape[1])
-    ok = rowwise_small(kc, akc, tol)
+    ok = rowwise_small(kc, akc, tol, floor=_floor(kmax, c))
     accepted = eye[:, ok]
     rest = eye[:, ~ok]
     if rest.shape[1] and accepted.shape[1]:
@@ -78,7 +87,7 @@ def rigid_basis(
         kr = g.T @ kcc @ g
         _, v = np.linalg.eigh(0.5 * (kr + kr.T))
         g = g @ v
-        good = rowwise_small(kc @ g, akc @ np.abs(g), tol)
+        good = rowwise_small(kc @ g, akc @ np.abs(g), tol, floor=_floor(kmax, c @ g))
         accepted = np.concatenate([accepted, g[:, good]], axis=1)
     if accepted.shape[1] == 0:
         return np.zeros((n, 0))
@@ -114,9 +123,31 @@ def _m_orthonormal_coefficients(gram: np.ndarray, coef: np.ndarray) -> np.ndarra
     return (coef * sc[None, :]) @ (v[:, keep] / np.sqrt(w[keep]))
 
 
-def rowwise_small(kx: np.ndarray, ax: np.ndarray, tol: float) -> np.ndarray:
-    """Columns whose products ``K x`` vanish row by row relative to ``|K| |x|``."""
+def _floor(kmax: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Row scale ``max_j |K_ij| * max |x|`` of each column of ``x``, (n, r)."""
+    return kmax[:, None] * np.max(np.abs(x), axis=0)[None, :] if x.size else np.zeros(x.shape)
+
+
+def rowwise_small(
+    kx: np.ndarray, ax: np.ndarray, tol: float, *, floor: np.ndarray | None = None
+) -> np.ndarray:
+    """Columns whose products ``K x`` vanish row by row relative to ``|K| |x|``.
+
+    Parameters
+    ----------
+    kx, ax : ndarray (n, r)
+        ``K x`` and ``|K| |x|``.
+    tol : float
+        Largest row-wise ratio.
+    floor : ndarray (n, r), optional
+        Each row's scale (the row's largest stiffness times the column's largest entry): a
+        ``K x`` below :data:`RIGID_FLOOR` of it is round-off and passes whatever ``|K| |x|``
+        is, so that round-off never reads as a restraint (slender bars, a DOF on a rotation's
+        axis, where ``|K| |x|`` is itself round-off).
+    """
     kx = np.abs(kx)
+    if floor is not None:
+        kx = np.where(kx <= RIGID_FLOOR * floor, 0.0, kx)
     ratio = np.where(ax > 0, kx / np.where(ax > 0, ax, 1.0), np.where(kx > 0, np.inf, 0.0))
     return np.max(ratio, axis=0) <= tol
 

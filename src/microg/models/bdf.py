@@ -107,7 +107,8 @@ SUPPORTED_CARDS = (
 # fmt: on
 # fmt: off
 #: cards read and ignored: they change neither stiffness nor mass (loads, solution control,
-#: output requests, analysis sets); counted in meta["ignored_cards"]
+#: output requests, analysis sets, thermal cards, tables); listed once in the warnings and
+#: counted in meta["ignored_cards"]
 IGNORED_CARDS = (
     "ENDDATA", "EIGRL", "EIGR", "EIGB", "EIGC", "USET", "USET1", "PLOTEL", "FORCE", "FORCE1",
     "FORCE2", "MOMENT", "MOMENT1", "MOMENT2", "LOAD", "GRAV", "RFORCE", "PLOAD", "PLOAD1",
@@ -116,6 +117,12 @@ IGNORED_CARDS = (
     "TABLED3", "TABLED4", "TABDMP1", "TSTEP", "TEMP", "TEMPD", "SPCD", "NLPARM", "ASET",
     "ASET1", "OMIT", "OMIT1", "QSET", "QSET1", "BSET", "BSET1", "CSET", "CSET1", "SUPORT",
     "SUPORT1", "MONPNT1", "DTI",
+    # thermal materials, boundary conditions and loads (no structural stiffness or mass)
+    "MAT4", "MAT5", "MATT4", "MATT5", "CONV", "PCONV", "RADBC", "RADM", "CHBDYE", "CHBDYG",
+    "CHBDYP", "PHBDY", "QBDY1", "QBDY2", "QBDY3", "QVOL", "QHBDY", "TEMPP1", "TEMPRB",
+    # material and load tables, sets, design optimisation, initial conditions
+    "TABLEM1", "TABLEM2", "TABLEM3", "TABLEM4", "TABLES1", "TABLEST", "SET1", "SET3",
+    "DESVAR", "DRESP1", "DRESP2", "DCONSTR", "DVPREL1", "DOPTPRM", "TIC",
 )
 # fmt: on
 
@@ -883,9 +890,11 @@ def load_bdf(
         )
     else:
         system = parse_units(str(units), where="units")
-    cards, case = read_cards(path)
+    notes: list[str] = []
+    cards, case = read_cards(path, notes)
     sc = Scales(system.length_m, system.force_N, system.time_s)
     deck = _Deck(cards, case, str(path), sc, wtmass, spc)
+    deck.warnings.extend(notes)
     graph = deck.build()
     if not points:
         return graph

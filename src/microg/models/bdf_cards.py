@@ -128,8 +128,21 @@ class _Line:
     number: int
 
 
-def _read_lines(path: Path, shown: str, depth: int, stack: tuple[Path, ...]) -> Iterator[_Line]:
-    """Lines of ``path`` with INCLUDEs expanded (file name and line number kept)."""
+def _read_lines(
+    path: Path,
+    shown: str,
+    depth: int,
+    stack: tuple[Path, ...],
+    notes: list[str] | None = None,
+    state: dict[str, bool] | None = None,
+) -> Iterator[_Line]:
+    """Lines of ``path`` with INCLUDEs expanded (file name and line number kept).
+
+    An INCLUDE before ``BEGIN BULK`` (executive or case control: DMAP alters, output
+    requests) that does not exist is skipped with a note in ``notes``; a bulk-data INCLUDE
+    must exist.
+    """
+    state = {"bulk": False} if state is None else state
     try:
         raw = path.read_bytes()
     except OSError as exc:
@@ -163,14 +176,24 @@ def _read_lines(path: Path, shown: str, depth: int, stack: tuple[Path, ...]) -> 
                     where=f"{shown}:{number}",
                     fix="remove the circular INCLUDE",
                 )
+            if not target.is_file() and not state["bulk"] and notes is not None:
+                notes.append(
+                    f"{shown}:{number}: INCLUDE {name[-60:]!r} before BEGIN BULK not found: "
+                    "skipped (executive and case control do not change the model)"
+                )
+                continue
             if not target.is_file():
                 raise InputError(
                     f"INCLUDE {name!r}: file not found",
                     where=f"{shown}:{number}",
                     fix="give the path relative to the including file",
                 )
-            yield from _read_lines(target, target_shown, depth + 1, (*stack, target.resolve()))
+            yield from _read_lines(
+                target, target_shown, depth + 1, (*stack, target.resolve()), notes, state
+            )
             continue
+        if not state["bulk"] and re.match(r"\s*BEGIN\s+(BULK|SUPER)", line, re.I):
+            state["bulk"] = True
         yield _Line(line, shown, number)
 
 
@@ -213,13 +236,16 @@ def _is_continuation(line: str) -> bool:
     return not line[:8].strip()
 
 
-def read_cards(path: str | Path) -> tuple[list[Card], list[str]]:
+def read_cards(path: str | Path, notes: list[str] | None = None) -> tuple[list[Card], list[str]]:
     """Bulk data cards of a deck and its case control lines.
 
     Parameters
     ----------
     path : str or Path
         The deck (``.bdf``, ``.dat``, ``.blk``, ``.nas``); INCLUDEs relative to it.
+    notes : list of str, optional
+        Receives a note per executive/case-control INCLUDE that does not exist (skipped);
+        without it such an INCLUDE is an error, as a bulk-data one always is.
 
     Returns
     -------
@@ -231,7 +257,14 @@ def read_cards(path: str | Path) -> tuple[list[Card], list[str]]:
     shown = str(path)
     if not p.is_file():
         raise InputError("file not found", where=shown, fix="check the path")
-    lines = list(_read_lines(p, shown, 0, (p.resolve(),)))
+    try:
+        top = p.read_bytes().decode("latin-1")
+    except OSError as exc:
+        raise InputError(f"cannot read the file: {exc.strerror or exc}", where=shown) from None
+    # a file without CEND or BEGIN BULK is bulk data throughout
+    bulk_only = not re.search(r"^\s*(CEND\b|BEGIN\s+(BULK|SUPER))", top, re.I | re.M)
+    state = {"bulk": bulk_only}
+    lines = list(_read_lines(p, shown, 0, (p.resolve(),), notes, state))
     begin = next(
         (k for k, ln in enumerate(lines) if re.match(r"\s*BEGIN\s+(BULK|SUPER)", ln.text, re.I)),
         None,
@@ -252,6 +285,7 @@ def read_cards(path: str | Path) -> tuple[list[Card], list[str]]:
     cards: list[Card] = []
     cur: list[Any] | None = None
     cur_at: tuple[str, int] = ("", 0)
+    pattern: list[str] | None = None
     for ln in lines:
         text = ln.text.split("$", 1)[0] if "$" in ln.text else ln.text
         if not text.strip():
@@ -274,14 +308,67 @@ def read_cards(path: str | Path) -> tuple[list[Card], list[str]]:
             continue
         if cur is not None:
             cards.append(_card(cur, cur_at))
+            cur = None
         if len(cards) >= MAX_CARDS:
             raise InputError(f"more than {MAX_CARDS} cards", where=shown, fix="split the model")
+        head = text.strip()
+        if head.startswith("="):
+            # replication (QRG "Bulk Data Entry Replication"): "=,..." one card from the
+            # previous one by a pattern, "=N" N more cards by the last pattern
+            if not cards:
+                raise InputError("a replication line before any card", where=where)
+            count = head.split(",")[0].strip()
+            if count == "=":
+                pattern = [f.strip() for f in text.split(",")[1:]]
+                times = 1
+            elif re.fullmatch(r"=\(?\d+\)?", count):
+                if pattern is None:
+                    raise InputError(f"{count!r} repeats no replication pattern", where=where)
+                times = int(count.strip("=()"))
+            else:
+                raise InputError(f"{count[:8]!r} is not a replication line", where=where)
+            if len(cards) + times > MAX_CARDS:
+                raise InputError(f"more than {MAX_CARDS} cards", where=shown, fix="split the model")
+            for _ in range(times):
+                cards.append(
+                    _card(_replicate(cards[-1].fields, pattern, where), (ln.file, ln.number))
+                )
+            continue
+        pattern = None  # "=N" repeats only a replication that directly precedes it
         name, data = _fields_of(text, where)
         cur = [name.strip().upper(), *(_value(f) for f in data)]
         cur_at = (ln.file, ln.number)
     if cur is not None:
         cards.append(_card(cur, cur_at))
     return cards, case
+
+
+def _replicate(prev: tuple[Any, ...], pattern: list[str], where: str) -> list[Any]:
+    """The card a replication pattern makes of ``prev``.
+
+    ``=`` copies a field, ``==`` all remaining ones, ``*x`` / ``*(x)`` adds ``x`` to it, a
+    blank is blank, anything else is the new value (MSC/NX QRG, "Bulk Data Entry
+    Replication").
+    """
+    out: list[Any] = [prev[0]]
+    for k, tok in enumerate(pattern, start=1):
+        old = prev[k] if k < len(prev) else None
+        if tok == "==":
+            out.extend(prev[k:])
+            return out
+        if tok == "=":
+            out.append(old)
+        elif tok.startswith("*"):
+            inc = _value(tok[1:].strip("()"))
+            if not isinstance(inc, int | float) or not isinstance(old, int | float):
+                raise InputError(
+                    f"replication {tok[:10]!r} increments a field that is not a number",
+                    where=where,
+                )
+            out.append(old + inc)
+        else:
+            out.append(_value(tok))
+    return out
 
 
 def _card(fields: list[Any], at: tuple[str, int]) -> Card:
