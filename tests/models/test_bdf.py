@@ -422,3 +422,18 @@ def test_declared_wtmass_one_contradicting_the_deck_is_an_error(tmp_path):
     with pytest.raises(InputError, match="contradicts wtmass = 1"):
         load_bdf(with_wt, units=parse_units("in, lbf, s", wtmass=1.0))
     assert load_bdf(with_wt, units=parse_units("in, lbf, s")).meta["wtmass"] == 0.00259
+
+
+def test_identical_repeated_cards_count_once_different_ones_are_errors(tmp_path):
+    # a boundary GRID in two INCLUDEd files (cla_test_data_2020's outboard.asm, large field
+    # with CD/PS/SEID written as 0, and inboard.blk, small field with them blank) is one grid
+    same = (
+        "GRID*   1               0               0.0             0.0\n"
+        "*       0.0             0               0               0\n"
+    )
+    deck = _deck(tmp_path, BASE + same)
+    g = load_bdf(deck, units="in, lbf, s")
+    assert sum(1 for n in g.nodes if n.name == "grid:1") == 1
+    other = _deck(tmp_path, BASE + "GRID,1,,0.5,0.,0.\n", "other.bdf")
+    with pytest.raises(InputError, match="duplicate grid id 1"):
+        load_bdf(other, units="in, lbf, s")

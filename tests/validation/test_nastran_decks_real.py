@@ -124,3 +124,16 @@ def test_missing_executive_include_is_skipped_bulk_include_is_not(tmp_path):
     (tmp_path / "bulk.inc").unlink()
     with pytest.raises(InputError, match="INCLUDE 'bulk.inc': file not found"):
         load_bdf(deck, units="in, lbf, s")
+
+
+def test_single_beam_deck_with_a_missing_dmap_alter_has_six_rigid_modes():
+    # nas2cam_no_se.dat (pyyeti nas2cam/no_se.dat, NX 5/1/14): one CBEAM, lumped mass, free;
+    # its executive control INCLUDEs a DMAP alter by an absolute path that is not here.
+    # Truth, its F06 (no_se.out): six modes at 3.35e-9 Hz and none other below the EIGRL
+    # limit of 100 Hz.  The bar's transverse rows, after its massless rotations are
+    # condensed, hold only round-off: the rigid-body test must not read them as a restraint
+    g = load_bdf(DATA / "nas2cam_no_se.dat", units="in, lbf, s")
+    assert any("before BEGIN BULK not found: skipped" in w for w in g.meta["warnings"])
+    md = solve_modes(discretize(g))
+    assert md.n_rigid == 6 and np.all(md.omega[:6] == 0.0)
+    assert md.freq_hz[6] > 100.0

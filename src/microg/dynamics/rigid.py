@@ -22,9 +22,10 @@ __all__ = ["RIGID_TOL", "rigid_basis", "m_orthonormal", "rowwise_small", "suppor
 #: exact rigid vectors of the frame models score ~1e-16; a restraint softer than 1e-12 of a
 #: row's stiffness cannot be told from rigid (documented limit)
 RIGID_TOL = 1e-12
-#: fraction of a row's largest stiffness times the vector's largest entry below which a
-#: row's K r is round-off (double precision, 2.2e-16, times the few hundred terms a row may
-#: sum); a restraint that soft is below RIGID_TOL's documented limit anyway
+#: fraction of the largest stiffness times the vector's largest entry below which a row's
+#: K r is round-off (double precision, 2.2e-16, times the few hundred terms a row or a
+#: condensation may sum); a restraint softer than this cannot be told from rigid
+#: (documented limit)
 RIGID_FLOOR = 1e-13
 
 
@@ -61,10 +62,11 @@ def rigid_basis(
     kc = stiffness @ c
     ak = abs(stiffness)
     akc = ak @ np.abs(c)
-    # the largest stiffness of each row's DOFs: a row whose |K||r| is itself round-off (a
-    # DOF on a rotation's axis) is judged against it, not against its own round-off
-    kmax = np.asarray(ak.max(axis=1).toarray() if hasattr(ak, "toarray") else ak.max(axis=1))
-    kmax = kmax.reshape(-1)
+    # the largest stiffness of the DOFs (condensation spreads its round-off over every row):
+    # a row whose |K||r| is itself round-off (a DOF on a rotation's axis, a transverse DOF of
+    # a bar whose massless rotations were condensed) is judged against it, not against its
+    # own round-off
+    kmax = np.full(n, float(ak.max()) if n else 0.0)
     mcc = c.T @ (mass @ c)
     mcc = 0.5 * (mcc + mcc.T)
     kcc = c.T @ kc
@@ -124,7 +126,7 @@ def _m_orthonormal_coefficients(gram: np.ndarray, coef: np.ndarray) -> np.ndarra
 
 
 def _floor(kmax: np.ndarray, x: np.ndarray) -> np.ndarray:
-    """Row scale ``max_j |K_ij| * max |x|`` of each column of ``x``, (n, r)."""
+    """Row scale ``kmax_i * max |x|`` of each column of ``x``, (n, r)."""
     return kmax[:, None] * np.max(np.abs(x), axis=0)[None, :] if x.size else np.zeros(x.shape)
 
 
@@ -140,7 +142,7 @@ def rowwise_small(
     tol : float
         Largest row-wise ratio.
     floor : ndarray (n, r), optional
-        Each row's scale (the row's largest stiffness times the column's largest entry): a
+        Each row's scale (the largest stiffness times the column's largest entry): a
         ``K x`` below :data:`RIGID_FLOOR` of it is round-off and passes whatever ``|K| |x|``
         is, so that round-off never reads as a restraint (slender bars, a DOF on a rotation's
         axis, where ``|K| |x|`` is itself round-off).
