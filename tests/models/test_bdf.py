@@ -13,8 +13,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from microg.dynamics.modes import solve_modes
 from microg.errors import InputError
 from microg.models.bdf import load_bdf
+from microg.structure.discretize import discretize
 from microg.structure.frame import assemble_frame, build_frame
 from microg.units import IN, LBF
 
@@ -437,3 +439,74 @@ def test_identical_repeated_cards_count_once_different_ones_are_errors(tmp_path)
     other = _deck(tmp_path, BASE + "GRID,1,,0.5,0.,0.\n", "other.bdf")
     with pytest.raises(InputError, match="duplicate grid id 1"):
         load_bdf(other, units="in, lbf, s")
+
+
+def _conm1_fields(m, d, j):
+    """CONM1's lower triangle of the rigid-body mass [[m I, -m S], [m S, J + m S^T S]]."""
+    s = np.array([[0, -d[2], d[1]], [d[2], 0, -d[0]], [-d[1], d[0], 0]])
+    mm = np.zeros((6, 6))
+    mm[:3, :3] = m * np.eye(3)
+    mm[:3, 3:] = -m * s
+    mm[3:, :3] = m * s
+    mm[3:, 3:] = j + m * s.T @ s
+    return [mm[i, k] for i in range(6) for k in range(i + 1)]
+
+
+def _card_lines(name, fields):
+    """A free-field card with continuations of 8 fields."""
+    vals = [str(v) if isinstance(v, int) else f"{v:.16e}" for v in fields]
+    first, rest = vals[:8], vals[8:]
+    lines = [",".join([name, *first])]
+    while rest:
+        lines.append(",".join(["", *rest[:8]]))
+        rest = rest[8:]
+    return "\n".join(lines) + "\n"
+
+
+def test_conm1_of_a_rigid_body_equals_the_conm2_it_encodes(tmp_path):
+    # hand reference: the 6x6 mass of a body of mass m at offset d with inertia J about its
+    # centre (Geradin & Rixen, rigid-body kinetic energy), written in a rotated CORD2R 7
+    m, d, j = (
+        3.0,
+        np.array([0.1, -0.2, 0.3]),
+        np.array([[4.0, 0.5, 0.0], [0.5, 5.0, 0.2], [0.0, 0.2, 6.0]]),
+    )
+    cord = "CORD2R,7,,0.,0.,0.,0.,0.,1.\n,1.,1.,0.\n"  # z along basic z, x along (1,1,0)
+    deck = _deck(tmp_path, BASE + cord + _card_lines("CONM1", [5, 1, 7, *_conm1_fields(m, d, j)]))
+    g = load_bdf(deck, units="m, N, s")
+    (cm,) = [x for x in g.masses if x.name == "conm1:5"]
+    ax = np.array([[1.0, 1.0, 0.0], [-1.0, 1.0, 0.0], [0.0, 0.0, 1.0]]) / np.array(
+        [[2**0.5], [2**0.5], [1.0]]
+    )
+    # CID 7 values rotated to basic: rows of ax are CID 7's axes in basic
+    assert cm.mass_kg == pytest.approx(m, rel=1e-14)
+    np.testing.assert_allclose(cm.offset_m, ax.T @ d, atol=1e-14)
+    np.testing.assert_allclose(cm.inertia_kg_m2, ax.T @ j @ ax, atol=1e-13)
+
+
+def test_conm1_masses_on_a_massless_bar_give_the_hand_frequencies(tmp_path):
+    # two CONM1 (mass m, polar inertia jx about the bar) on a massless CBAR of length 1:
+    # axial mode omega^2 = 2 E A / (L m), torsion omega^2 = 2 G J / (L jx) (two equal
+    # masses on a spring, free-free), to the eigen solver's rounding
+    E, nu, A, J, m, jx = 2.0e5, 0.3, 1e-2, 2e-5, 2.0, 0.05
+    G = E / (2 * (1 + nu))
+    body = [
+        "GRID,1,,0.,0.,0.", "GRID,2,,1.,0.,0.", f"MAT1,1,{E},,{nu},0.",
+        f"PBAR,10,1,{A},1e-5,1e-5,{J}", "CBAR,1,10,1,2,0.,1.,0.",
+    ]  # fmt: skip
+    jj = np.diag([jx, 0.01, 0.01])
+    text = "\n".join(body) + "\n"
+    for eid, gid in ((11, 1), (12, 2)):
+        text += _card_lines("CONM1", [eid, gid, 0, *_conm1_fields(m, np.zeros(3), jj)])
+    md = solve_modes(discretize(load_bdf(_deck(tmp_path, text), units="m, N, s")))
+    f = md.freq_hz
+    for w2 in (2 * E * A / m, 2 * G * J / jx):
+        assert np.min(np.abs(f - np.sqrt(w2) / (2 * np.pi))) <= 1e-9 * np.sqrt(w2)
+
+
+def test_conm1_that_is_not_a_rigid_body_is_refused(tmp_path):
+    fields = _conm1_fields(1.0, np.zeros(3), np.eye(3))
+    fields[2] = 2.0  # M22 != M11
+    deck = _deck(tmp_path, BASE + _card_lines("CONM1", [5, 1, 0, *fields]))
+    with pytest.raises(InputError, match="only the mass of a rigid body"):
+        load_bdf(deck, units="m, N, s")

@@ -12,7 +12,8 @@ material cards.
 
 **Cards converted:** GRID (CP, CD), CORD2R/C/S, CBAR, CBEAM, BAROR, BEAMOR, PBAR, PBARL,
 PBEAM (uniform), PBEAML (uniform), CROD, PROD, CONROD, CBUSH + PBUSH (K, B, GE), CELAS1 +
-PELAS, CELAS2, CONM2, RBE2, RBE3 (translational independent components), MAT1, PARAM
+PELAS, CELAS2, CONM2, CONM1 (a rigid body's 6x6 mass), RBE2, RBE3 (translational
+independent components), MAT1, PARAM
 (WTMASS, COUPMASS; K6ROT noted), SPC, SPC1, SPCADD (noted as constraints).
 
 **Cards ignored by name** (they change no stiffness or mass: loads, solution and output
@@ -102,7 +103,7 @@ __all__ = [
 SUPPORTED_CARDS = (
     "GRID", "CORD2R", "CORD2C", "CORD2S", "CBAR", "CBEAM", "BAROR", "BEAMOR", "PBAR", "PBARL",
     "PBEAM", "PBEAML", "CROD", "PROD", "CONROD", "CBUSH", "PBUSH", "CELAS1", "CELAS2", "PELAS",
-    "CONM2", "RBE2", "RBE3", "MAT1", "PARAM", "SPC", "SPC1", "SPCADD",
+    "CONM2", "CONM1", "RBE2", "RBE3", "MAT1", "PARAM", "SPC", "SPC1", "SPCADD",
 )
 # fmt: on
 # fmt: off
@@ -224,7 +225,7 @@ class _Deck:
         rods = self.rods(mats, grid_pos, wt)
         springs = self.bushes(grid_pos, grid_axes, frames)
         scalars = self.scalar_springs()
-        masses = self.conm2(grid_pos, frames, wt)
+        masses = self.conm2(grid_pos, frames, wt) + self.conm1(grid_pos, frames, wt)
         links, interps = self.rigid(grid_pos)
         constraints = self.constraints(grid_pos)
         for ps_node, comps in self.grid_ps:
@@ -682,6 +683,60 @@ class _Deck:
             ename = f"conm2:{eid}"
             self.origin[ename] = c
             out.append(ConcentratedMass(ename, node, m, off, j))
+        return out
+
+    def conm1(
+        self, pos: dict[int, np.ndarray], frames: dict[int, CoordinateFrame], wt: float
+    ) -> list[ConcentratedMass]:
+        """CONM1: a 6x6 mass at a grid (lower triangle, in CID at the grid), as a rigid body.
+
+        The matrix must be a rigid body's, ``[[m I, -m S(d)], [m S(d), J + m S(d)^T S(d)]]``
+        with ``S(d) x = d x x`` (mass m at offset d, inertia J about its centre): one mass in
+        the three directions and an antisymmetric coupling, to 1e-9.  Anything else
+        (different masses per direction) is refused.
+        """
+        sc = self.sc
+        out: list[ConcentratedMass] = []
+        for eid, c in self.by_id(("CONM1",), "element").items():
+            gid = c.raw(2)
+            node = self.grid(gid, c, pos, "G")
+            cid = c.integer(3, "CID", 0)
+            mm = np.zeros((6, 6))
+            k = 4
+            for i in range(6):
+                for j in range(i + 1):
+                    mm[i, j] = mm[j, i] = c.real(k, f"M{i + 1}{j + 1}", 0.0)
+                    k += 1
+            scale = np.ones(6)
+            scale[3:] = sc.length
+            mm = mm * np.outer(scale, scale) * wt * sc.mass
+            if cid != 0:
+                ax = self.frame(frames, cid, c).axes_at(pos[gid])
+                t = np.zeros((6, 6))
+                t[:3, :3] = t[3:, 3:] = ax.T  # columns: the system's axes in basic
+                mm = t @ mm @ t.T
+            m = float(mm[0, 0])
+            big = max(abs(m), float(np.abs(mm).max()), 1e-300)
+            if (
+                m < 0
+                or np.abs(mm[:3, :3] - m * np.eye(3)).max() > 1e-9 * big
+                or np.abs(mm[:3, 3:] + mm[:3, 3:].T).max() > 1e-9 * big
+                or (m == 0 and np.abs(mm[:3, 3:]).max() > 0)
+            ):
+                raise c.error(
+                    "only the mass of a rigid body is supported (M11 = M22 = M33 >= 0, no "
+                    "translational cross terms, an antisymmetric translation-rotation block)",
+                    fix="give the mass as CONM2 (mass, offset, inertia)",
+                )
+            sd = -mm[:3, 3:] / m if m > 0 else np.zeros((3, 3))
+            d = np.array([sd[2, 1], sd[0, 2], sd[1, 0]])
+            j = mm[3:, 3:] - m * (sd.T @ sd)
+            j = 0.5 * (j + j.T)
+            if np.linalg.eigvalsh(j).min() < -1e-9 * max(float(np.abs(j).max()), 1e-300):
+                raise c.error("the rotational block is not a positive semidefinite inertia")
+            ename = f"conm1:{eid}"
+            self.origin[ename] = c
+            out.append(ConcentratedMass(ename, node, m, d, j))
         return out
 
     def rigid(self, pos: dict[int, np.ndarray]) -> tuple[list[RigidLink], list[Interpolation]]:
