@@ -510,3 +510,26 @@ def test_conm1_that_is_not_a_rigid_body_is_refused(tmp_path):
     deck = _deck(tmp_path, BASE + _card_lines("CONM1", [5, 1, 0, *fields]))
     with pytest.raises(InputError, match="only the mass of a rigid body"):
         load_bdf(deck, units="m, N, s")
+
+
+def test_celas2_and_cbush_frequencies_equal_the_hand_solution(tmp_path):
+    # hand solutions, one-DOF oscillators: a grid with CONM2 mass 2 and inertia diag(1, 2, 3)
+    # on six grounded CELAS2 springs k = 10..60 gives omega^2 = k_i / m_i; two coincident
+    # grids (masses 1 and 3, inertias 1 and 2) joined by a CBUSH K = 1..6 (CID 0 axes) give
+    # six rigid modes and omega^2 = k_i (1/m_a + 1/m_b); to the eigen solver's rounding
+    ks = [10.0, 20.0, 30.0, 40.0, 50.0, 60.0]
+    text = "GRID,1,,0.,0.,0.\nCONM2,1,1,,2.,,,,,+\n+,1.,,2.,,,3.\n"
+    text += "".join(f"CELAS2,{10 + c},{k},1,{c}\n" for c, k in enumerate(ks, start=1))
+    md = solve_modes(discretize(load_bdf(_deck(tmp_path, text), units="m, N, s")))
+    want = np.sqrt(np.array(ks) / np.array([2.0, 2.0, 2.0, 1.0, 2.0, 3.0]))
+    np.testing.assert_allclose(np.sort(md.omega), np.sort(want), rtol=1e-12)
+    text = (
+        "GRID,2,,0.,0.,0.\nGRID,3,,0.,0.,0.\n"
+        "CONM2,2,2,,1.,,,,,+\n+,1.,,1.,,,1.\nCONM2,3,3,,3.,,,,,+\n+,2.,,2.,,,2.\n"
+        "PBUSH,5,K,1.,2.,3.,4.,5.,6.\nCBUSH,1,5,2,3,,,,0\n"
+    )
+    md = solve_modes(discretize(load_bdf(_deck(tmp_path, text, "bush.bdf"), units="m, N, s")))
+    assert md.n_rigid == 6
+    inv = np.array([1 / 1 + 1 / 3] * 3 + [1 / 1 + 1 / 2] * 3)
+    want = np.sqrt(np.arange(1.0, 7.0) * inv)
+    np.testing.assert_allclose(np.sort(md.omega[6:]), np.sort(want), rtol=1e-12)
