@@ -186,7 +186,8 @@ def test_rigid_fit_on_two_grids_is_not_trusted_without_a_mass(ioc_fe):
     sub = phi[[0, 5]]
     _, _, rigid, rep, warn = replace_rigid_modes(f, sub, xyz[[0, 5]])
     assert rep is None and not rigid.any() and "cannot confirm" in warn[0]
-    c, *_ = np.linalg.lstsq(rigid_basis_at(xyz).reshape(-1, 6), phi[:, :, :6].reshape(-1, 6))
+    r_all, p_all = rigid_basis_at(xyz).reshape(-1, 6), phi[:, :, :6].reshape(-1, 6)
+    c, *_ = np.linalg.lstsq(r_all, p_all, rcond=None)
     ci = np.linalg.inv(c)
     mrr = ci.T @ ci
     om, _, rigid, rep, _ = replace_rigid_modes(f, sub, xyz[[0, 5]], rigid_mass=mrr)
