@@ -730,13 +730,13 @@ class _Deck:
                 )
             sd = -mm[:3, 3:] / m if m > 0 else np.zeros((3, 3))
             d = np.array([sd[2, 1], sd[0, 2], sd[1, 0]])
-            j = mm[3:, 3:] - m * (sd.T @ sd)
-            j = 0.5 * (j + j.T)
-            if np.linalg.eigvalsh(j).min() < -1e-9 * max(float(np.abs(j).max()), 1e-300):
+            jc = mm[3:, 3:] - m * (sd.T @ sd)
+            jc = 0.5 * (jc + jc.T)
+            if np.linalg.eigvalsh(jc).min() < -1e-9 * max(float(np.abs(jc).max()), 1e-300):
                 raise c.error("the rotational block is not a positive semidefinite inertia")
             ename = f"conm1:{eid}"
             self.origin[ename] = c
-            out.append(ConcentratedMass(ename, node, m, d, j))
+            out.append(ConcentratedMass(ename, node, m, d, jc))
         return out
 
     def rigid(self, pos: dict[int, np.ndarray]) -> tuple[list[RigidLink], list[Interpolation]]:
