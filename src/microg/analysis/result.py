@@ -274,6 +274,44 @@ class Analysis:
 
         return analysis_figure(self, ax=ax)
 
+    def plot3d(self) -> Any:
+        """The model in 3-D, force and observed points marked, a slider over the elastic modes.
+
+        A plotly Figure (:func:`microg.plotting.interactive.modes_3d`).
+        """
+        from microg.plotting.interactive import modes_3d
+
+        forces = {d.point: d.unit_direction for d in self.options.disturbances}
+        if self.options.sources is not None:
+            for src in self.options.sources.sources:
+                forces.setdefault(src.at, src.direction)
+        return modes_3d(self.modes, force_points=forces, observed=list(self.observations))
+
+    def _repr_html_(self) -> str:
+        """The verdict table in a notebook: each point's peak, band verdict and margin."""
+        from html import escape
+
+        rows = []
+        for name, o in self.observations.items():
+            to = o.assessment.third_octave
+            judged = np.asarray(to.margin)[:, np.asarray(to.judged, bool)]
+            margin = float(judged.min()) if judged.size else float("nan")
+            if o.complies:
+                status = "complies"
+            elif margin < 1.0:
+                status = "fails"
+            else:  # every judged band passes, yet no pass: bands the record cannot resolve
+                status = "not shown (unresolved bands exceed their limits)"
+            rows.append(
+                f"<tr><td>{escape(name)}</td><td>{o.peak_accel_g:.3g}</td>"
+                f"<td>{margin:.3g}</td><td>{status}</td></tr>"
+            )
+        return (
+            f"<p><b>{escape(str(self.model))}</b> against {escape(self.requirement.name)}</p>"
+            "<table><tr><th>point</th><th>peak (g)</th><th>smallest band margin</th>"
+            f"<th>band verdict</th></tr>{''.join(rows)}</table>"
+        )
+
 
 def _disturbance_dict(d: Disturbance) -> dict[str, Any]:
     f = d.force

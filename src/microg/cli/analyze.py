@@ -205,6 +205,11 @@ def _weight_to_mass(text: str) -> str:
     help="Directory for report.html, figures and results.json (replaced as a whole).",
 )
 @click.option("--json", "as_json", is_flag=True, help="Also print results.json to stdout.")
+@click.option(
+    "--static",
+    is_flag=True,
+    help="Write report.html with PNG figures only (no interactive 3-D view, ~4.8 MB smaller).",
+)
 @click.option("--no-progress", is_flag=True, help="Hide the progress bar.")
 def analyze(
     model: str,
@@ -231,6 +236,7 @@ def analyze(
     sources: str | None,
     out_dir: Path,
     as_json: bool,
+    static: bool,
     no_progress: bool,
 ) -> None:
     """Microgravity environment of MODEL (a model file or a shipped name; default: ioc).
@@ -297,7 +303,7 @@ def analyze(
             **kwargs,
         )
         progress("report")
-        path, text = write_outputs(result, out_dir)
+        path, text = write_outputs(result, out_dir, static=static)
     bar.update(1)
     bar.close()
     if as_json:
@@ -318,17 +324,21 @@ def _check_out(out_dir: Path) -> None:
     check_writable(out_dir, where="--out")
 
 
-def write_outputs(result: Any, out_dir: Path) -> tuple[Path, str]:
+def write_outputs(result: Any, out_dir: Path, *, static: bool = False) -> tuple[Path, str]:
     """Render figures, HTML and JSON, and write them into ``out_dir`` as one run.
 
-    Returns the directory and the JSON text (``result.to_dict()``, what ``--json`` prints).
+    ``static``: the report with PNG figures only.  Returns the directory and the JSON text
+    (``result.to_dict()``, what ``--json`` prints).
     """
     from microg._io import dumps, write_output_files
     from microg.report.analysis import report_files
 
     summary = result.to_dict()
     text = dumps(summary)
-    files: dict[str, bytes | str] = {**report_files(result, summary), "results.json": text}
+    files: dict[str, bytes | str] = {
+        **report_files(result, summary, static=static),
+        "results.json": text,
+    }
     return write_output_files(out_dir, files, where="--out"), text
 
 

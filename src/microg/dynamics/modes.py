@@ -246,6 +246,35 @@ class Modes:
 
         return plot_modes(self, ax=ax, **kwargs)
 
+    def plot3d(self, **kwargs: Any) -> Any:
+        """The model in 3-D with a slider over the elastic modes (a plotly Figure).
+
+        Keywords as :func:`microg.plotting.interactive.modes_3d` (``force_points``,
+        ``observed``, ``title``).
+        """
+        from microg.plotting.interactive import modes_3d
+
+        return modes_3d(self, **kwargs)
+
+    def _repr_html_(self) -> str:
+        """The modes table in a notebook: number, frequency, kind, modal mass."""
+        from html import escape
+
+        kind = np.where(self.rigid, "rigid", "elastic")
+        if self.unstable is not None:
+            kind = np.where(self.unstable, "unstable", kind)
+        rows = "".join(
+            f"<tr><td>{j + 1}</td><td>{self.freq_hz[j]:.4g}</td><td>{kind[j]}</td>"
+            f"<td>{self.modal_mass[j]:.3g}</td></tr>"
+            for j in range(min(self.n_modes, 60))
+        )
+        more = f"<p>... {self.n_modes - 60} more</p>" if self.n_modes > 60 else ""
+        return (
+            f"<p><b>{escape(str(self.method))}</b>: {self.n_modes} modes, "
+            f"{int(np.count_nonzero(self.rigid))} rigid</p><table><tr><th>mode</th>"
+            f"<th>frequency (Hz)</th><th>kind</th><th>modal mass (kg)</th></tr>{rows}</table>{more}"
+        )
+
 
 def effective_mass(
     mass: Any, phi: np.ndarray, rigid_body: Mapping[str, np.ndarray]

@@ -21,6 +21,7 @@ __all__ = [
     "figure_builders",
     "figure_names",
     "figures",
+    "interactive_model",
     "render_analysis",
     "report_files",
 ]
@@ -143,7 +144,9 @@ def figures(result: Analysis) -> dict[str, bytes]:
     return {name: png_bytes(build()) for name, build in figure_builders(result).items()}
 
 
-def report_files(result: Analysis, summary: dict[str, Any] | None = None) -> dict[str, Any]:
+def report_files(
+    result: Analysis, summary: dict[str, Any] | None = None, *, static: bool = False
+) -> dict[str, Any]:
     """The report's files: every figure's PNG bytes, in report order, then ``report.html``.
 
     Parameters
@@ -151,9 +154,18 @@ def report_files(result: Analysis, summary: dict[str, Any] | None = None) -> dic
     result : Analysis
     summary : dict, optional
         ``result.to_dict()``, if the caller has it already.
+    static : bool
+        PNG figures only: leave out the interactive 3-D view (and plotly.js, ~4.8 MB).
     """
     figs = figures(result)
-    return {**figs, "report.html": render_analysis(result, figs, summary)}
+    return {**figs, "report.html": render_analysis(result, figs, summary, static=static)}
+
+
+def interactive_model(result: Analysis) -> str:
+    """The 3-D model and mode-shape slider as an HTML fragment, plotly.js inlined once."""
+    from microg.plotting.interactive import plotly_html
+
+    return plotly_html(result.plot3d(), div_id="model3d", include_plotlyjs=True)
 
 
 @lru_cache(maxsize=1)
@@ -165,7 +177,11 @@ def _analysis_template() -> Any:
 
 
 def render_analysis(
-    result: Analysis, figs: dict[str, bytes], summary: dict[str, Any] | None = None
+    result: Analysis,
+    figs: dict[str, bytes],
+    summary: dict[str, Any] | None = None,
+    *,
+    static: bool = False,
 ) -> str:
     """Self-contained HTML of the analysis, figures embedded as data URIs.
 
@@ -176,6 +192,8 @@ def render_analysis(
         PNG bytes by file name (:func:`figures`).
     summary : dict, optional
         ``result.to_dict()``, if the caller has it already.
+    static : bool
+        Leave out the interactive 3-D view (PNG figures only).
     """
     from microg import __version__
     from microg.report.html import png_data_uri
@@ -224,5 +242,6 @@ def render_analysis(
             model_fig=uris["model.png"],
             forces_fig=uris.get("forces.png"),
             modes_fig=uris["modes.png"],
+            model3d=None if static else interactive_model(result),
         )
     )
