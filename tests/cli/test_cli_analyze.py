@@ -149,10 +149,10 @@ window.addEventListener("load", async () => {
   const gd = document.getElementById("model3d");
   try {
     rendered = gd.classList.contains("js-plotly-plot") && gd.querySelector("canvas") ? 1 : 0;
-    const before = JSON.stringify(gd.data[1].x.slice(0, 30));
+    const before = JSON.stringify(Array.from(gd._fullData[1].x).slice(0, 30));
     const step = gd.layout.sliders[0].steps[3];
     await Plotly.animate(gd, ...step.args);
-    changed = JSON.stringify(gd.data[1].x.slice(0, 30)) !== before ? 1 : 0;
+    changed = JSON.stringify(Array.from(gd._fullData[1].x).slice(0, 30)) !== before ? 1 : 0;
     title = gd.layout.title.text;
   } catch (e) { window.__errors.push("probe: " + e); }
   const b = document.body;

@@ -61,18 +61,15 @@ def _ordered(pos: np.ndarray, groups: list[np.ndarray]) -> list[np.ndarray]:
     return out
 
 
-def _lines(p: np.ndarray, groups: list[np.ndarray]) -> tuple[list[float], ...]:
-    """x, y, z lists of the components, each broken from the next by None (plotly's gap)."""
-    xs: list[Any] = []
-    ys: list[Any] = []
-    zs: list[Any] = []
-    for g in groups:
-        if g.size == 0:
-            continue
-        xs += [*p[g, 0].tolist(), None]
-        ys += [*p[g, 1].tolist(), None]
-        zs += [*p[g, 2].tolist(), None]
-    return xs, ys, zs
+def _lines(p: np.ndarray, groups: list[np.ndarray]) -> tuple[np.ndarray, ...]:
+    """x, y, z arrays of the components, each broken from the next by NaN (a gap in the line).
+
+    float32 (7 digits: far below a pixel of the view), so plotly writes them as compact typed
+    arrays and validates them without looping over the values.
+    """
+    parts = [np.vstack([p[g], np.full((1, 3), np.nan)]) for g in groups if g.size]
+    xyz = np.concatenate(parts).astype(np.float32) if parts else np.zeros((0, 3), np.float32)
+    return xyz[:, 0], xyz[:, 1], xyz[:, 2]
 
 
 def _mode_title(modes: Modes, j: int) -> str:
