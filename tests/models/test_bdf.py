@@ -287,6 +287,20 @@ def test_unsupported_cards_listed_by_name_and_count(tmp_path):
     _one_line(exc, "deck.bdf", "unsupported cards: CQUAD4 (2), MAT8 (1), PSHELL (1)", "GRID")
 
 
+def test_an_included_file_that_is_not_a_deck_is_never_echoed(tmp_path):
+    # INCLUDE '/etc/passwd' was read and the error listed the first 8 characters of each of
+    # its lines ("ROOT:X:0 (1), DAEMON:X ..."); a user name that looks like a card name
+    # ("messagebus" -> MESSAGEB) leaked too.  Now: the count and the first line's place only
+    secret = tmp_path / "secrets.txt"
+    secret.write_text("root:x:0:0:root:/root:/bin/bash\nmessagebus:x:101:102::/x\nTOKEN12 abc\n")
+    text = BASE + f"INCLUDE '{secret}'\n"
+    with pytest.raises(InputError) as exc:
+        load_bdf(_deck(tmp_path, text), units="m, N, s")
+    msg = _one_line(exc, "3 line(s) that are not NASTRAN cards", f"{secret}:1")
+    for leak in ("ROOT", "MESSAGEB", "TOKEN12", "abc", "bash"):
+        assert leak not in msg.replace(str(tmp_path), "").upper(), leak
+
+
 def test_missing_property_material_grid_zero_length_include(tmp_path):
     cases = [
         (BASE.replace("CBAR,1,10", "CBAR,1,11"), ("deck.bdf:5: CBAR 1", "property 11", "add")),

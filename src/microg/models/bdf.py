@@ -147,6 +147,10 @@ def _same_card(a: Card, b: Card) -> bool:
     return norm(a) == norm(b)
 
 
+#: the form of a NASTRAN card name (at most 8 characters, a letter first)
+_CARD_NAME = re.compile(r"^[A-Z][A-Z0-9]{0,7}$")
+
+
 class _Deck:
     """Converts cards to a GraphModel (private)."""
 
@@ -189,9 +193,21 @@ class _Deck:
             k: v for k, v in counts.items() if k not in SUPPORTED_CARDS and k not in IGNORED_CARDS
         }
         if unsupported:
-            listing = ", ".join(f"{k} ({v})" for k, v in sorted(unsupported.items()))
+            # a name is quoted only when it has the form of a NASTRAN card name: the lines of
+            # a file that is not a deck (an INCLUDEd /etc/passwd) are counted, never echoed
+            # (and nothing of a file that holds such a line: it is not a deck)
+            bad = [c for c in self.cards if c.name in unsupported]
+            foreign = {c.file for c in bad if not _CARD_NAME.match(c.name)}
+            junk = [c for c in bad if c.file in foreign]
+            named = Counter(c.name for c in bad if c.file not in foreign)
+            parts = [f"{k} ({v})" for k, v in sorted(named.items())]
+            if junk:
+                parts.append(
+                    f"{len(junk)} line(s) that are not NASTRAN cards (first at "
+                    f"{junk[0].file}:{junk[0].line})"
+                )
             raise InputError(
-                f"unsupported cards: {listing}",
+                f"unsupported cards: {', '.join(parts)}",
                 where=self.path,
                 fix="microg's frame elements read "
                 + " ".join(SUPPORTED_CARDS)
