@@ -132,10 +132,15 @@ def assess(
         payload = merge_assessments(results)
         if out_dir is not None:
             from microg._io import write_output_files
+            from microg.report.environment import render_assessment
 
             files: dict[str, bytes | str] = {"results.json": dumps(payload)}
+            per_sensor: dict[str, dict[str, bytes]] = {}
             for r in results:
-                files.update(_figures(r))
+                figs = _figures(r)
+                per_sensor[r["key"]] = {k: v for k, v in figs.items() if isinstance(v, bytes)}
+                files.update(figs)
+            files["report.html"] = render_assessment(payload, per_sensor)
             path = write_output_files(out_dir, files, where="out")
     if as_json:
         click.echo(dumps(payload))

@@ -275,13 +275,16 @@ def _write(result: Any, data: dict[str, Any], out_dir: Path) -> None:
     import io
 
     from microg._io import dumps, write_run_directory
+    from microg.report.environment import render_quasi_steady
 
     files: dict[str, bytes | str] = {"quasi-steady.json": dumps(data)}
+    png = None
     if result.map is not None:
         files["quasi-steady-map.csv"] = result.map.to_csv()
         buf = io.BytesIO()
         result.plot().savefig(buf, format="png", dpi=110)
-        files["quasi-steady-map.png"] = buf.getvalue()
+        png = files["quasi-steady-map.png"] = buf.getvalue()
+    files["report.html"] = render_quasi_steady(data, png)
     write_run_directory(out_dir, files, where="--out")
 
 

@@ -1,0 +1,66 @@
+"""HTML pages of ``microg assess`` and ``microg quasi-steady``: every verdict line follows from
+the fields beside it, and every band row and named point is on the page."""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+
+import pytest
+
+from microg.cli import main
+from microg.report.environment import band_verdict
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+@pytest.mark.parametrize(
+    ("obs", "verdict", "css"),
+    [
+        ({"complies": True, "worst_band": {"margin": 5.6}}, "complies", "pass"),
+        ({"complies": False, "worst_band": {"margin": 0.4}}, "fails (margin 0.4)", "fail"),
+        (
+            {
+                "complies": False,
+                "worst_band": {"margin": 1.47},
+                "third_octave": {"unresolved_exceeding_hz": [0.1]},
+            },
+            "not shown: bands the record cannot resolve exceed their limits",
+            "undecided",
+        ),
+        ({"complies": False, "worst_band": None}, "not shown", "undecided"),
+    ],
+)
+def test_each_band_verdict_follows_its_fields(obs, verdict, css):
+    # never "complies" unless the result says so; "fails" only on a judged margin below 1
+    assert band_verdict(obs) == (verdict, css)
+
+
+def test_assess_writes_a_report_with_every_band(tmp_path: Path) -> None:
+    out = tmp_path / "a"
+    assert main(["assess", str(ROOT / "examples" / "measured.csv"), "--out", str(out)]) == 0
+    html = (out / "report.html").read_text()
+    d = json.loads((out / "results.json").read_text())
+    (key, obs), = d["observations"].items()
+    to = obs["third_octave"]
+    rows = re.findall(r'<tr class="(unjudged|fail|)">\s*<td>', html)
+    assert len(rows) == len(to["center_hz"])
+    # a band the record does not resolve is marked on its row, whatever its value
+    assert [r == "unjudged" for r in rows] == [not r for r in to["resolved"]]
+    assert key in html and band_verdict(obs)[0] in html
+    assert len(re.findall(r'<img [^>]*src="data:image/png;base64,', html)) == len(
+        list(out.glob("*.png"))
+    )
+
+
+def test_quasi_steady_writes_a_report_with_every_point(tmp_path: Path) -> None:
+    out = tmp_path / "q"
+    assert main(["quasi-steady", "ioc", "--out", str(out)]) == 0
+    html = (out / "report.html").read_text()
+    d = json.loads((out / "quasi-steady.json").read_text())
+    for name, p in d["points"].items():
+        row = html.split(f'<td class="l">{name}</td>', 1)[1].split("</tr>", 1)[0]
+        assert f"{p['magnitude_g'] * 1e6:.3g}" in row
+        word = {True: "complies", False: "fails", None: "undecided"}[p["complies"]]
+        assert word in row
