@@ -38,12 +38,13 @@ the rattlespace and the force by the actuator limit (Bryson's rule).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from microg.errors import InputError
+from microg.isolation.active.margins import loop_margin_values
 from microg.isolation.active.plant import DOF_NAMES, ActivePlant, gain
 
 if TYPE_CHECKING:
@@ -250,39 +251,6 @@ def _channel_loop(
 _DESIGN_OMEGA = 2 * math.pi * np.geomspace(1e-6, 2e4, 1500)
 
 
-def loop_margin_values(
-    loop: Any, omega: np.ndarray
-) -> tuple[float, float, float | None, float | None]:
-    """(gain margin, phase margin in degrees, gain- and phase-crossover in rad/s) of a SISO loop.
-
-    Read by :func:`control.stability_margins` (``returnall``) from the loop's frequency
-    response at ``omega`` (rad/s), interpolated.  A loop may cross |L| = 1 and -180 deg more
-    than once: the phase margin is the least angular distance from -180 deg over the gain
-    crossovers (a phase of -258 deg is 78 deg from it), the gain margin the crossing factor
-    nearest to 1 on a log scale (a factor below 1 means that *reducing* the gain by it
-    destabilises: a conditionally stable loop); inf where there is no crossover.
-    """
-    import control as ct
-
-    gms, pms, _, wpcs, wgcs, _ = ct.stability_margins(
-        ct.frd(loop, omega, smooth=True), returnall=True
-    )
-    gms, pms = np.atleast_1d(np.asarray(gms, float)), np.atleast_1d(np.asarray(pms, float))
-    wpcs, wgcs = np.atleast_1d(np.asarray(wpcs, float)), np.atleast_1d(np.asarray(wgcs, float))
-    gm, wpc = math.inf, None
-    ok = np.isfinite(gms) & (gms > 0)
-    if ok.any():
-        j = int(np.argmin(np.abs(np.log(gms[ok]))))
-        gm, wpc = float(gms[ok][j]), float(wpcs[ok][j])
-    pm, wgc = math.inf, None
-    okp = np.isfinite(pms)
-    if okp.any():
-        dist = np.abs((pms[okp] + 180.0) % 360.0 - 180.0)
-        j = int(np.argmin(dist))
-        pm, wgc = float(dist[j]), float(wgcs[okp][j])
-    return gm, pm, wgc, wpc
-
-
 def _margins_ok(loop: Any) -> tuple[bool, float, float]:
     import control as ct
 
@@ -305,16 +273,38 @@ def _largest(ok: Any, lo: float, hi: float, rel: float = 0.01) -> float | None:
     return lo
 
 
-def design_feedback(plant: ActivePlant, target: Target, *, pade_order: int = 3) -> Controller:
-    """Acceleration feedback with centring designed to ``target`` (module docstring).
+#: acceleration-loop gains already searched, by plant and Pade order (the search depends on
+#: nothing else: ``microg analyze`` designs the same preset for every observed point)
+_GAINS_CACHE: dict[tuple[Any, ...], np.ndarray] = {}
+_GAINS_CACHE_SIZE = 32
+
+
+def plant_key(plant: ActivePlant) -> tuple[Any, ...]:
+    """A hashable fingerprint of every parameter of ``plant`` (arrays by value)."""
+    out: list[Any] = []
+    for f in fields(plant):
+        if f.name in ("sources", "name"):
+            continue
+        v = getattr(plant, f.name)
+        out.append(None if v is None else np.asarray(v, float).tobytes())
+    return tuple(out)
+
+
+def accel_loop_gains(plant: ActivePlant, pade_order: int = 3) -> np.ndarray:
+    """Each channel's largest acceleration-loop gain keeping the margins, (6,), rad/s.
+
+    The bisection of :func:`design_feedback` (module docstring), cached per plant and Pade
+    order (a copy is returned).
 
     Parameters
     ----------
     plant : the plant
-    target : the transmissibility target (translational channels)
     pade_order : order of the delay's Pade approximant in the design model
     """
-    notes: list[str] = []
+    key = (plant_key(plant), pade_order)
+    hit = _GAINS_CACHE.get(key)
+    if hit is not None:
+        return hit.copy()
     top = 2 * math.pi * min(0.5 * plant.sample_rate_hz, plant.max_loop_hz)
     wa = np.zeros(6)
     for i in range(6):
@@ -331,6 +321,24 @@ def design_feedback(plant: ActivePlant, target: Target, *, pade_order: int = 3) 
                 fix="raise the sampling rate or the accelerometer bandwidth, or shorten the delay",
             )
         wa[i] = best
+    if len(_GAINS_CACHE) >= _GAINS_CACHE_SIZE:
+        _GAINS_CACHE.pop(next(iter(_GAINS_CACHE)))
+    _GAINS_CACHE[key] = wa.copy()
+    return wa
+
+
+def design_feedback(plant: ActivePlant, target: Target, *, pade_order: int = 3) -> Controller:
+    """Acceleration feedback with centring designed to ``target`` (module docstring).
+
+    Parameters
+    ----------
+    plant : the plant
+    target : the transmissibility target (translational channels)
+    pade_order : order of the delay's Pade approximant in the design model
+    """
+    notes: list[str] = []
+    top = 2 * math.pi * min(0.5 * plant.sample_rate_hz, plant.max_loop_hz)
+    wa = accel_loop_gains(plant, pade_order)
     capped = [n for n, w in zip(DOF_NAMES, wa, strict=True) if w >= top * (1 - 1e-9)]
     notes.append(
         f"acceleration loops at the largest gain keeping {PM_MIN_DEG:g} deg / "

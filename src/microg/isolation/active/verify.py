@@ -30,7 +30,9 @@ from typing import Any
 import numpy as np
 
 from microg.errors import InputError
-from microg.isolation.active.controller import Controller, loop_margin_values
+from microg.isolation.active.controller import Controller
+from microg.isolation.active.fresp import freq_response
+from microg.isolation.active.margins import margins_from_response
 from microg.isolation.active.plant import DOF_NAMES, ActivePlant, gain
 
 __all__ = [
@@ -42,7 +44,10 @@ __all__ = [
     "disturbance_response",
     "noise_psd",
     "noise_band_rms",
+    "noise_floor",
+    "base_and_disturbance",
     "time_response",
+    "loops_at_a_time",
     "NOISE_NODES",
 ]
 
@@ -173,8 +178,6 @@ def loop_margins(
 
     Returns the margins and each loop's response ``L_i`` at ``freq_hz`` (6, nf), complex.
     """
-    import control as ct
-
     gen = plant.generalized(pade_order, discrete=discrete)
     dt = 1.0 / plant.sample_rate_hz if discrete else None
     k = _controller(plant, controller, discrete)
@@ -183,17 +186,13 @@ def loop_margins(
     model = "discrete" if discrete else "continuous"
     f_top = 0.499 * plant.sample_rate_hz if discrete else 20.0 * plant.sample_rate_hz
     omega = 2 * math.pi * np.geomspace(MARGIN_F_LO_HZ, f_top, MARGIN_POINTS)
-    out = []
     fr = np.asarray(freq_hz if freq_hz is not None else [], float)
-    resp = np.zeros((6, fr.size), complex)
+    # one frequency response of H = K P_yu (python-control) on the margins' grid and the
+    # curves' frequencies; every loop follows from it by the algebra of the docstring
+    loops = loops_at_a_time(_fresp(h, np.concatenate([omega / (2 * math.pi), fr])))
+    out = []
     for i, name in enumerate(DOF_NAMES):
-        e = np.eye(6)
-        e[i, i] = 0.0
-        closed = ct.feedback(h, gain(e, dt), sign=1)
-        li = -(_select(6, [i], dt) * closed * _inputs(6, [i], dt))
-        gm, pm, wgc, wpc = loop_margin_values(li, omega)
-        if fr.size:
-            resp[i] = _fresp(li, fr)[0, 0]
+        gm, pm, wgc, wpc = margins_from_response(loops[i, : omega.size], omega)
         out.append(
             LoopMargin(
                 loop=name,
@@ -204,7 +203,27 @@ def loop_margins(
                 phase_crossover_hz=_freq(wpc),
             )
         )
-    return out, resp
+    return out, loops[:, omega.size :]
+
+
+def loops_at_a_time(h: np.ndarray) -> np.ndarray:
+    """Each loop ``L_i = -[(I - H E_i)^-1 H]_ii`` from ``H = K P_yu``, (n, nf) complex.
+
+    Parameters
+    ----------
+    h : (n, n, nf) the frequency response of ``H`` (controller times plant, actuator to
+        actuator), complex; ``E_i`` is the identity with its ``i``-th diagonal entry zero
+        (every loop closed but the ``i``-th, positive feedback as ``u = K y``)
+    """
+    n = h.shape[0]
+    hf = np.moveaxis(np.asarray(h, complex), -1, 0)  # (nf, n, n)
+    out = np.empty((n, hf.shape[0]), complex)
+    for i in range(n):
+        e = np.eye(n)
+        e[i, i] = 0.0
+        closed = np.linalg.solve(np.eye(n)[None] - hf @ e[None], hf)
+        out[i] = -closed[:, i, i]
+    return out
 
 
 def _num(v: Any) -> float:
@@ -222,10 +241,8 @@ def _freq(w: Any) -> float | None:
 
 
 def _fresp(system: Any, freq_hz: np.ndarray) -> np.ndarray:
-    """Complex frequency response (nout, nin, nf) at ``freq_hz``."""
-    w = 2 * math.pi * np.asarray(freq_hz, float)
-    resp = system.frequency_response(w, squeeze=False)
-    return np.asarray(resp.complex, complex).reshape(system.noutputs, system.ninputs, w.size)
+    """Complex frequency response (nout, nin, nf) at ``freq_hz`` (:func:`.fresp.freq_response`)."""
+    return freq_response(system, freq_hz)
 
 
 def transmissibility_matrix(cl: Any, freq_hz: np.ndarray) -> np.ndarray:
@@ -240,6 +257,43 @@ def disturbance_response(cl: Any, freq_hz: np.ndarray) -> np.ndarray:
     return _fresp(sub, freq_hz)
 
 
+def base_and_disturbance(cl: Any, freq_hz: np.ndarray) -> np.ndarray:
+    """Base (x, y, z) and force/torque (6) to platform acceleration, complex (6, 9, nf).
+
+    ``[:3, :3]`` is :func:`transmissibility_matrix`, ``[:, 3:]`` :func:`disturbance_response`,
+    from one frequency response.
+    """
+    sub = _select(18, range(6)) * cl * _inputs(21, range(9))
+    return _fresp(sub, freq_hz)
+
+
+def noise_floor(
+    cl: Any, plant: ActivePlant, freq_hz: np.ndarray, lower_hz: np.ndarray, upper_hz: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`noise_psd` at ``freq_hz`` and :func:`noise_band_rms` over the bands, at once.
+
+    Returns the PSD (3, nf), (m/s^2)^2/Hz, and the band RMS (3, nb), m/s^2, from one frequency
+    response at the curves' frequencies and the bands' quadrature nodes.
+    """
+    f = np.asarray(freq_hz, float).reshape(-1)
+    nodes, jac = _band_nodes(lower_hz, upper_hz)
+    psd = noise_psd(cl, plant, np.concatenate([f, nodes.ravel()]))
+    band = psd[:, f.size :].reshape(3, *nodes.shape)
+    return psd[:, : f.size], np.sqrt(np.sum(band * jac[None], axis=2))
+
+
+def _band_nodes(lower_hz: np.ndarray, upper_hz: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss-Legendre nodes in log f per band (nb, NOISE_NODES), Hz, and their weights in f."""
+    lo = np.asarray(lower_hz, float)
+    hi = np.asarray(upper_hz, float)
+    x, wq = np.polynomial.legendre.leggauss(NOISE_NODES)
+    u = 0.5 * (x + 1.0)  # on [0, 1]
+    lf = np.log(lo)[:, None] + (np.log(hi) - np.log(lo))[:, None] * u[None, :]
+    f = np.exp(lf)  # (nb, nodes)
+    jac = (np.log(hi) - np.log(lo))[:, None] * 0.5 * wq[None, :] * f  # df = f dlnf
+    return f, jac
+
+
 def noise_psd(cl: Any, plant: ActivePlant, freq_hz: np.ndarray) -> np.ndarray:
     """Platform linear-acceleration PSD from the sensors' noises, (3, nf), (m/s^2)^2/Hz."""
     sub = _select(18, range(3)) * cl * _inputs(21, range(9, 21))
@@ -252,14 +306,8 @@ def noise_band_rms(
     cl: Any, plant: ActivePlant, lower_hz: np.ndarray, upper_hz: np.ndarray
 ) -> np.ndarray:
     """Band RMS of the noise floor per axis, (3, nb), m/s^2 (Gauss-Legendre in log f)."""
-    lo = np.asarray(lower_hz, float)
-    hi = np.asarray(upper_hz, float)
-    x, wq = np.polynomial.legendre.leggauss(NOISE_NODES)
-    u = 0.5 * (x + 1.0)  # on [0, 1]
-    lf = np.log(lo)[:, None] + (np.log(hi) - np.log(lo))[:, None] * u[None, :]
-    f = np.exp(lf)  # (nb, nodes)
+    f, jac = _band_nodes(lower_hz, upper_hz)
     psd = noise_psd(cl, plant, f.ravel()).reshape(3, *f.shape)
-    jac = (np.log(hi) - np.log(lo))[:, None] * 0.5 * wq[None, :] * f  # df = f dlnf
     return np.sqrt(np.sum(psd * jac[None], axis=2))
 
 

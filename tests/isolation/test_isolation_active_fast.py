@@ -1,0 +1,158 @@
+"""The active check's fast paths against the straightforward python-control computations.
+
+* the vectorised frequency response (Schur form) against a dense solve at every frequency;
+* the loops broken one at a time from one response of ``H = K P_yu`` against
+  ``control.feedback`` of the state spaces;
+* the margins read on windows around the crossings against the whole-grid reading;
+* the acceleration-loop search cached per plant.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+ct = pytest.importorskip("control")
+
+from microg.isolation.active import verify  # noqa: E402
+from microg.isolation.active.controller import (  # noqa: E402
+    _DESIGN_OMEGA,
+    OMEGA_P_MIN,
+    _channel_loop,
+    accel_loop_gains,
+    design_feedback,
+)
+from microg.isolation.active.fresp import freq_response  # noqa: E402
+from microg.isolation.active.margins import (  # noqa: E402
+    loop_margin_values,
+    margins_from_response,
+    pick_margins,
+)  # noqa: E402
+from microg.isolation.active.plant import DOF_NAMES, gain  # noqa: E402
+from microg.isolation.active.presets import load_preset  # noqa: E402
+from microg.isolation.active.target import target_by_name  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def aris():
+    plant, name = load_preset("aris")
+    return plant, design_feedback(plant, target_by_name(name))
+
+
+def _normwise(ref: np.ndarray, got: np.ndarray) -> float:
+    num = np.linalg.norm(ref - got, axis=(0, 1))
+    return float(np.max(num / np.linalg.norm(ref, axis=(0, 1))))
+
+
+@pytest.mark.parametrize("discrete", [False, True])
+def test_vectorised_response_matches_a_dense_solve(aris, discrete) -> None:
+    plant, ctrl = aris
+    cl = verify.closed_loop(plant, ctrl, discrete=discrete)
+    sub = verify._select(18, range(6)) * cl * verify._inputs(21, range(9))
+    f = np.geomspace(1e-4, 0.49 * plant.sample_rate_hz, 60)[::-1]  # any order
+    got = freq_response(sub, f)
+    n = sub.nstates
+    z = np.exp(2j * np.pi * f * sub.dt) if discrete else 2j * np.pi * f
+    ref = np.stack(
+        [sub.C @ np.linalg.solve(zi * np.eye(n) - sub.A, sub.B) + sub.D for zi in z], axis=-1
+    )
+    # tolerance: a backward-stable solve's forward error is about eps * cond; cond(A) is ~1e9
+    # (continuous: Pade poles at ~1e4 1/s beside umbilical poles at ~1e-2 1/s) and ~1e11
+    # (sampled); python-control's own per-point response differs from the dense solve by the
+    # same order (5e-9 and 1.5e-6 here)
+    tol = 10 * np.finfo(float).eps * np.linalg.cond(sub.A)
+    assert _normwise(ref, got) < tol
+    # the diagonal transmissibility pointwise, where the checks read it
+    for i in range(3):
+        assert np.max(np.abs(got[i, i] - ref[i, i]) / np.abs(ref[i, i])) < tol
+
+
+def test_loops_at_a_time_match_control_feedback(aris) -> None:
+    plant, ctrl = aris
+    gen = plant.generalized(3)
+    p_yu = verify._select(30, range(18, 30)) * gen * verify._inputs(27, range(21, 27))
+    h = ctrl.system * p_yu
+    f = np.geomspace(1e-3, 100.0, 40)
+    fast = verify.loops_at_a_time(freq_response(h, f))
+    for i in range(len(DOF_NAMES)):
+        e = np.eye(6)
+        e[i, i] = 0.0
+        closed = ct.feedback(h, gain(e), sign=1)
+        li = -(verify._select(6, [i]) * closed * verify._inputs(6, [i]))
+        ref = freq_response(li, f)[0, 0]
+        # 1e-6: two algebraically equal forms of the same loop (a 6x6 complex solve per
+        # frequency against the state-space feedback), both within the closed loop's
+        # conditioning (above)
+        assert np.max(np.abs(fast[i] - ref) / np.abs(ref)) < 1e-6
+
+
+def _whole_grid(loop, omega):
+    gms, pms, _, wpcs, wgcs, _ = ct.stability_margins(
+        ct.frd(loop, omega, smooth=True), returnall=True
+    )
+    return pick_margins(gms, pms, wpcs, wgcs)
+
+
+@pytest.mark.parametrize("wa_hz", [0.3, 3.0, 30.0])
+@pytest.mark.parametrize("channel", [0, 3])
+def test_windowed_margins_equal_the_whole_grid(channel, wa_hz) -> None:
+    plant, _ = load_preset("aris")
+    loop = _channel_loop(plant, channel, 2 * math.pi * wa_hz, OMEGA_P_MIN, 3)
+    resp = freq_response(loop, _DESIGN_OMEGA / (2 * math.pi))[0, 0]
+    # the windows alone: the same response read on the whole grid and on the windows
+    whole = ct.frd(resp, _DESIGN_OMEGA, smooth=True)
+    gms, pms, _, wpcs, wgcs, _ = ct.stability_margins(whole, returnall=True)
+    ref = pick_margins(gms, pms, wpcs, wgcs)
+    got = margins_from_response(resp, _DESIGN_OMEGA)
+    for r, g in zip(ref, got, strict=True):
+        if r is None or not math.isfinite(r):
+            assert g == r
+        else:
+            # 1e-10: a cubic spline's end condition decays ~0.27 per knot, WINDOW = 8 knots
+            # from the crossing; measured ~1e-12
+            assert abs(g - r) <= 1e-10 * abs(r)
+    # end to end against python-control's own response on the whole grid
+    end_to_end = zip(
+        _whole_grid(loop, _DESIGN_OMEGA), loop_margin_values(loop, _DESIGN_OMEGA), strict=True
+    )
+    for r, g in end_to_end:
+        if r is None or not math.isfinite(r):
+            assert g == r
+        else:
+            # 1e-6: the two responses differ by up to ~1e-7 at the loop's low-frequency
+            # crossings (|L| ~ 20 there: the per-point solves' conditioning, test above)
+            assert abs(g - r) <= 1e-6 * abs(r)
+
+
+def test_margins_of_the_design_match_the_whole_grid(aris) -> None:
+    plant, ctrl = aris
+    fast, _ = verify.loop_margins(plant, ctrl)
+    gen = plant.generalized(3)
+    p_yu = verify._select(30, range(18, 30)) * gen * verify._inputs(27, range(21, 27))
+    h = ctrl.system * p_yu
+    omega = (
+        2
+        * math.pi
+        * np.geomspace(verify.MARGIN_F_LO_HZ, 20.0 * plant.sample_rate_hz, verify.MARGIN_POINTS)
+    )
+    for i, m in enumerate(fast):
+        e = np.eye(6)
+        e[i, i] = 0.0
+        li = -(verify._select(6, [i]) * ct.feedback(h, gain(e), sign=1) * verify._inputs(6, [i]))
+        gm, pm, _, _ = _whole_grid(li, omega)
+        # 1e-6: as above, through the coupled loop's conditioning
+        assert abs(m.phase_margin_deg - pm) <= 1e-6 * pm
+        assert abs(m.gain_margin - gm) <= 1e-6 * gm
+
+
+def test_acceleration_gains_are_cached_per_plant() -> None:
+    plant, _ = load_preset("aris")
+    first = accel_loop_gains(plant)
+    again = accel_loop_gains(load_preset("aris")[0])
+    assert np.array_equal(first, again)
+    again[0] = -1.0  # a copy: the cache is not changed through it
+    assert accel_loop_gains(plant)[0] == first[0]
+    other = accel_loop_gains(plant.with_(max_loop_hz=1.0))
+    assert other.max() <= 2 * math.pi * 1.0 * (1 + 1e-12)
