@@ -221,6 +221,15 @@ def active(
             "the closed loop is unstable: " + "; ".join(n for n in res.notes if "unstable" in n),
             where="--controller",
         )
+    missed = controller != "off" and not res.meets_target and not allow_miss
+    if missed and res.binding_limit is None and not res.margins_kept:
+        least = min(res.margins, key=lambda m: m.phase_margin_deg)
+        raise InputError(
+            f"the {res.controller.kind} design does not keep the loop margins (loop {least.loop}: "
+            f"{least.phase_margin_deg:.3g} deg of phase, {least.gain_margin_db:.3g} dB of gain)",
+            where="--controller",
+            fix="use another controller or relax the plant's limits, or pass --allow-miss",
+        )
     if controller != "off" and not res.meets_target and not allow_miss:
         raise InputError(
             f"target {res.target.name} is out of reach: the {res.binding_limit} limit binds ("

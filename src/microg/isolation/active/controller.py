@@ -30,9 +30,7 @@ that still meets the target with a factor ``DESIGN_MARGIN`` to spare (the least 
 the target).
 Rotational channels get their own ``omega_a`` and the translational ``omega_p``.
 
-:func:`design_h2` synthesises an H2 (LQG) controller with :func:`control.h2syn` (slycot) on the
-generalized plant, weighting the platform acceleration over the target's band, the stroke by
-the rattlespace and the force by the actuator limit (Bryson's rule).
+The H2 (LQG) design per decoupled axis is :func:`microg.isolation.active.h2.design_h2`.
 """
 
 from __future__ import annotations
@@ -56,7 +54,6 @@ __all__ = [
     "feedback_controller",
     "channel_transmissibility",
     "design_feedback",
-    "design_h2",
     "loop_margin_values",
     "no_controller",
     "PM_MIN_DEG",
@@ -75,10 +72,6 @@ GM_MIN = 2.0
 DESIGN_MARGIN = 0.8
 #: the acceleration loop's high-pass sits this fraction of the isolation corner
 LEAK_RATIO = 0.1
-#: H2 synthesis: least accelerometer noise relative to the base level, and least position
-#: noise (m/sqrt(Hz)) (conditioning of the filter Riccati equation)
-SYNTH_NOISE_RATIO = 0.03
-SYNTH_POSITION_NOISE_M = 1e-4
 #: least centring, rad/s (keeps a platform without umbilical stiffness centred)
 OMEGA_P_MIN = 2 * math.pi * 1e-4
 
@@ -392,90 +385,3 @@ def design_feedback(plant: ActivePlant, target: Target, *, pade_order: int = 3) 
         )
     )
     return Controller("designed", feedback_controller(plant, wa, wp), wa, wp, tuple(notes))
-
-
-def design_h2(plant: ActivePlant, target: Target, *, pade_order: int = 3) -> Controller:
-    """H2 (LQG) controller by :func:`control.h2syn` (needs slycot), Bryson-weighted.
-
-    Performance outputs: the platform's linear acceleration through a band-pass over the
-    target's span (weight 1 / 1e-6 g), the relative translation over the rattlespace and the
-    actuator force over its limit; exogenous inputs: the base acceleration (1e-4 g, white), the
-    sensors' noises at their PSDs (with floors, :data:`SYNTH_NOISE_RATIO`), and a direct
-    measurement noise (the synthesis needs a
-    full-rank ``D21``).  The plant's accelerometer bandwidth must be finite (``D22 = 0``).
-
-    Parameters
-    ----------
-    plant : the plant
-    target : the target (its span sets the band-pass)
-    pade_order : order of the delay's Pade approximant
-    """
-    import control as ct
-
-    try:
-        import slycot  # noqa: F401
-    except ImportError:
-        raise InputError(
-            "the H2 design needs slycot (pip install 'microg[h2]')",
-            where="controller",
-            fix="install slycot, or use --controller designed",
-        ) from None
-    if not math.isfinite(plant.accel_bandwidth_hz):
-        raise InputError(
-            "the H2 design needs a finite accelerometer bandwidth", where="accel-bandwidth"
-        )
-    from microg.units import G0
-
-    gen = plant.generalized(pade_order)  # [a0, d, n_a, n_p, u] -> [a, q, f, a_m, q_m]
-    f_lo, f_hi = target.span_hz()
-    wl, wh = 2 * math.pi * max(f_lo, 1e-4), 2 * math.pi * min(f_hi, 0.2 * plant.sample_rate_hz)
-    bp = ct.ss(ct.tf([wh, 0.0], [1.0, wl + wh, wl * wh]))  # unit gain between wl and wh
-    stroke, force = plant.limits()
-    w_a = ct.append(*([bp * (1.0 / (1e-6 * G0))] * 3))
-    w_q, w_f = np.diag(1.0 / stroke), np.diag(1.0 / force)
-    # z = [W_a a_lin, q / stroke, f / force]; w = [a0 (3), n_a (6), n_p (6), n_y (6)]
-    sel_z = np.zeros((15, 30))
-    sel_z[0:3, 0:3] = np.eye(3)
-    sel_z[3:9, 6:12] = w_q
-    sel_z[9:15, 12:18] = w_f
-    zsys = ct.append(w_a, gain(np.eye(12))) * gain(sel_z)  # 30 outputs -> 15
-    ysel = np.hstack([np.zeros((12, 18)), np.eye(12)])
-    outs = ct.append(zsys, gain(np.eye(12))) * gain(np.vstack([np.eye(30), ysel]))
-    a0_w = 1e-4 * G0
-    # the synthesis' noise intensities have floors (the filter Riccati equation is not solved
-    # for sensor noise 1e-3 of the base level); the verification uses the plant's real noise
-    na_w = max(math.sqrt(plant.accel_noise_psd), SYNTH_NOISE_RATIO * a0_w)
-    np_w = max(math.sqrt(plant.position_noise_psd), SYNTH_POSITION_NOISE_M)
-    # synthesis inputs [a0, n_a, n_p, u] (d is left out: it feeds the acceleration directly)
-    gen_w = gen * gain(_exo_map(a0_w, na_w, np_w))
-    full = outs * gen_w
-    direct = np.zeros((full.noutputs, 6))
-    direct[15:21, :] = na_w * np.eye(6)
-    p = ct.ss(
-        full.A,
-        np.hstack([full.B[:, :15], np.zeros((full.nstates, 6)), full.B[:, 15:]]),
-        full.C,
-        np.hstack([full.D[:, :15], direct, full.D[:, 15:]]),
-    )
-    try:
-        k = ct.h2syn(p, 12, 6)
-    except Exception as exc:  # slycot reports a failed Riccati solution as a ValueError
-        raise InputError(
-            f"the H2 synthesis failed ({type(exc).__name__}: {exc})",
-            where="controller",
-            fix="use --controller designed",
-        ) from None
-    return Controller("h2", k, None, None, (f"H2 synthesis (control.h2syn): {k.nstates} states",))
-
-
-def _exo_map(a0_w: float, na_w: float, np_w: float) -> np.ndarray:
-    """Weights of the synthesis inputs ``[a0, n_a, n_p, u]`` on the plant's inputs.
-
-    Parameters: the base acceleration's, the accelerometers' and the position sensors' levels.
-    """
-    m = np.zeros((27, 21))
-    m[0:3, 0:3] = a0_w * np.eye(3)
-    m[9:15, 3:9] = na_w * np.eye(6)
-    m[15:21, 9:15] = np_w * np.eye(6)
-    m[21:27, 15:21] = np.eye(6)
-    return m

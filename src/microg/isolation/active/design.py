@@ -30,7 +30,6 @@ from microg.isolation.active.controller import (
     CONTROLLERS,
     Controller,
     design_feedback,
-    design_h2,
     no_controller,
 )
 from microg.isolation.active.plant import ActivePlant
@@ -106,6 +105,8 @@ def _controller(plant: ActivePlant, kind: str, target: Target, pade_order: int) 
     if kind == "off":
         return no_controller()
     if kind == "h2":
+        from microg.isolation.active.h2 import design_h2
+
         return design_h2(plant, target, pade_order=pade_order)
     raise InputError(
         f"unknown controller {kind!r}", where="controller", fix=f"use {', '.join(CONTROLLERS)}"
