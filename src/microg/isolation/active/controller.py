@@ -36,14 +36,14 @@ The H2 (LQG) design per decoupled axis is :func:`microg.isolation.active.h2.desi
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from microg.errors import InputError
 from microg.isolation.active.margins import loop_margin_values
-from microg.isolation.active.plant import DOF_NAMES, ActivePlant, gain
+from microg.isolation.active.plant import DOF_NAMES, ActivePlant, gain, plant_key
 
 if TYPE_CHECKING:
     from microg.isolation.active.target import Target
@@ -270,17 +270,6 @@ def _largest(ok: Any, lo: float, hi: float, rel: float = 0.01) -> float | None:
 #: nothing else: ``microg analyze`` designs the same preset for every observed point)
 _GAINS_CACHE: dict[tuple[Any, ...], np.ndarray] = {}
 _GAINS_CACHE_SIZE = 32
-
-
-def plant_key(plant: ActivePlant) -> tuple[Any, ...]:
-    """A hashable fingerprint of every parameter of ``plant`` (arrays by value)."""
-    out: list[Any] = []
-    for f in fields(plant):
-        if f.name in ("sources", "name"):
-            continue
-        v = getattr(plant, f.name)
-        out.append(None if v is None else np.asarray(v, float).tobytes())
-    return tuple(out)
 
 
 def accel_loop_gains(plant: ActivePlant, pade_order: int = 3) -> np.ndarray:

@@ -40,7 +40,7 @@ q_m (6)]``.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field, fields, replace
 from typing import Any
 
 import numpy as np
@@ -48,7 +48,7 @@ import numpy as np
 from microg.errors import InputError
 from microg.units import G0
 
-__all__ = ["ActivePlant", "DOF_NAMES", "N_EXO", "gain", "rigid_transform"]
+__all__ = ["ActivePlant", "DOF_NAMES", "N_EXO", "gain", "plant_key", "rigid_transform"]
 
 #: names of the six rigid-body coordinates (and of the six control loops)
 DOF_NAMES = ("x", "y", "z", "rx", "ry", "rz")
@@ -105,6 +105,22 @@ def _scalar(
         need = ">= 0" if allow_zero else "> 0"
         raise InputError(f"must be a finite number {need}, got {value!r}", where=where)
     return v
+
+
+#: generalized plants already built (by plant, Pade order, model), at most _CACHE_SIZE
+_GEN_CACHE: dict[tuple[Any, ...], Any] = {}
+_CACHE_SIZE = 32
+
+
+def plant_key(plant: ActivePlant) -> tuple[Any, ...]:
+    """A hashable fingerprint of every physical parameter of ``plant`` (arrays by value)."""
+    out: list[Any] = []
+    for f in fields(plant):
+        if f.name in ("sources", "name"):
+            continue
+        v = getattr(plant, f.name)
+        out.append(None if v is None else np.asarray(v, float).tobytes())
+    return tuple(out)
 
 
 @dataclass(frozen=True)
@@ -358,12 +374,25 @@ class ActivePlant:
     def generalized(self, pade_order: int = 3, *, discrete: bool = False) -> Any:
         """The generalized plant of the module docstring, ``control.StateSpace``.
 
+        Built once per plant (by value, :func:`plant_key`), Pade order and model, and shared:
+        callers must not modify it.
+
         Parameters
         ----------
         pade_order : order of the Pade approximant of the actuator delay (continuous model)
         discrete : the sampled model instead: ZOH at ``sample_rate_hz`` (:func:`control.c2d`)
             and the computation delay in whole samples
         """
+        key = (plant_key(self), pade_order, discrete)
+        hit = _GEN_CACHE.get(key)
+        if hit is None:
+            hit = self._generalized(pade_order, discrete)
+            if len(_GEN_CACHE) >= _CACHE_SIZE:
+                _GEN_CACHE.pop(next(iter(_GEN_CACHE)))
+            _GEN_CACHE[key] = hit
+        return hit
+
+    def _generalized(self, pade_order: int, discrete: bool) -> Any:
         import control as ct
 
         phys = self.physical()  # [a0, d, f] -> [a, q, f]

@@ -33,7 +33,7 @@ from microg.errors import InputError
 from microg.isolation.active.controller import Controller
 from microg.isolation.active.fresp import freq_response
 from microg.isolation.active.margins import margins_from_response
-from microg.isolation.active.plant import DOF_NAMES, ActivePlant, gain
+from microg.isolation.active.plant import DOF_NAMES, ActivePlant, gain, plant_key
 
 __all__ = [
     "LoopMargin",
@@ -48,6 +48,7 @@ __all__ = [
     "base_and_disturbance",
     "time_response",
     "loops_at_a_time",
+    "plant_yu_response",
     "NOISE_NODES",
 ]
 
@@ -178,18 +179,20 @@ def loop_margins(
 
     Returns the margins and each loop's response ``L_i`` at ``freq_hz`` (6, nf), complex.
     """
-    gen = plant.generalized(pade_order, discrete=discrete)
-    dt = 1.0 / plant.sample_rate_hz if discrete else None
     k = _controller(plant, controller, discrete)
-    p_yu = _select(30, range(18, 30), dt) * gen * _inputs(27, range(21, 27), dt)
-    h = k * p_yu
     model = "discrete" if discrete else "continuous"
     f_top = 0.499 * plant.sample_rate_hz if discrete else 20.0 * plant.sample_rate_hz
     omega = 2 * math.pi * np.geomspace(MARGIN_F_LO_HZ, f_top, MARGIN_POINTS)
     fr = np.asarray(freq_hz if freq_hz is not None else [], float)
-    # one frequency response of H = K P_yu (python-control) on the margins' grid and the
-    # curves' frequencies; every loop follows from it by the algebra of the docstring
-    loops = loops_at_a_time(_fresp(h, np.concatenate([omega / (2 * math.pi), fr])))
+    # H = K P_yu on the margins' grid and the curves' frequencies, from the responses of K and
+    # of the plant's P_yu (the latter kept per plant: every design of one plant shares it);
+    # every loop follows from H by the algebra of the docstring
+    f_all = np.concatenate([omega / (2 * math.pi), fr])
+    p_grid = plant_yu_response(plant, omega / (2 * math.pi), pade_order, discrete)
+    p_fr = plant_yu_response(plant, fr, pade_order, discrete) if fr.size else p_grid[..., :0]
+    p_all = np.concatenate([p_grid, p_fr], axis=2)
+    h = np.einsum("ijf,jkf->ikf", _fresp(k, f_all), p_all)
+    loops = loops_at_a_time(h)
     out = []
     for i, name in enumerate(DOF_NAMES):
         gm, pm, wgc, wpc = margins_from_response(loops[i, : omega.size], omega)
@@ -204,6 +207,40 @@ def loop_margins(
             )
         )
     return out, loops[:, omega.size :]
+
+
+#: P_yu responses on the margins' grids already computed (by plant, grid, Pade order, model)
+_PYU_CACHE: dict[tuple[Any, ...], np.ndarray] = {}
+_PYU_CACHE_SIZE = 16
+
+
+def plant_yu_response(
+    plant: ActivePlant, freq_hz: np.ndarray, pade_order: int = 3, discrete: bool = False
+) -> np.ndarray:
+    """Frequency response of the plant from the actuator commands to the measurements.
+
+    ``P_yu``: (12, 6, nf) complex, ``u`` (6) to ``y = [a_m, q_m]`` (12), kept per plant,
+    frequencies, Pade order and model (a copy is not made: do not modify it).
+
+    Parameters
+    ----------
+    plant : the plant
+    freq_hz : (nf,) frequencies, Hz
+    pade_order : order of the delay's Pade approximant (continuous model)
+    discrete : the sampled model
+    """
+    f = np.asarray(freq_hz, float).reshape(-1)
+    key = (plant_key(plant), f.tobytes(), pade_order, discrete)
+    hit = _PYU_CACHE.get(key)
+    if hit is None:
+        dt = 1.0 / plant.sample_rate_hz if discrete else None
+        gen = plant.generalized(pade_order, discrete=discrete)
+        p_yu = _select(30, range(18, 30), dt) * gen * _inputs(27, range(21, 27), dt)
+        hit = _fresp(p_yu, f)
+        if len(_PYU_CACHE) >= _PYU_CACHE_SIZE:
+            _PYU_CACHE.pop(next(iter(_PYU_CACHE)))
+        _PYU_CACHE[key] = hit
+    return hit
 
 
 def loops_at_a_time(h: np.ndarray) -> np.ndarray:
