@@ -8,6 +8,8 @@ process: ``frequency_response`` of the closed loop at the curves' frequencies an
 the margins, the assessments).
 
 Sizes: frequency points 200, 1000, 5000 (no record); record lengths 50, 200, 800 s at 100 Hz.
+The H2 design (``controller="h2"``, target ``aris``) beside the ``control.h2syn`` calls alone
+of its six chosen channel weights (its scan synthesises a grid of weights per channel).
 
 Run: ``.venv/bin/python benchmarks/bench_active.py`` (about a minute).
 """
@@ -54,6 +56,23 @@ def main() -> None:
         t_d = _best(lambda t=t, a=a: design_active("aris", timepts=t, base_accel=a), 2)
         t_c = _best(lambda t=t, a=a: ct.forced_response(sub, t, a))
         print(f"{f'{dur:g}-s record':>22} {t_d:16.3f} {t_c:16.4f} {t_d / t_c:8.1f}")
+    try:
+        import slycot  # noqa: F401
+    except ImportError:
+        print(f"{'h2 design':>22} skipped (slycot missing: the h2 extra)")
+        return
+    from microg.isolation.active import h2
+    from microg.isolation.active.target import target_by_name
+
+    r = design_active("aris", controller="h2", target="aris")
+    rhos = [
+        float(x) for x in r.controller.notes[0].split(": ", 1)[1].replace(",", "").split()[1::2]
+    ]
+    w = h2._weight(target_by_name("aris"), r.plant)
+    plants = [h2.channel_plant(r.plant, i, rhos[i], w)[0] for i in range(6)]
+    t_d = _best(lambda: design_active("aris", controller="h2", target="aris"), 1)
+    t_c = _best(lambda: [ct.h2syn(p, 2, 1) for p in plants])
+    print(f"{'h2 design':>22} {t_d:16.3f} {t_c:16.4f} {t_d / t_c:8.1f}")
 
 
 if __name__ == "__main__":
