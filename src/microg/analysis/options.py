@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 
+from microg import defaults
 from microg._vectors import parse_direction
 from microg.dynamics.forces import ForceHistory
 from microg.units import LB
@@ -35,17 +36,17 @@ MAX_SAMPLES = 2_000_000
 REQUIREMENT_INTERVAL_S = 100.0
 #: modes solved for a sparse model when vibratory sources are assessed (their bands reach 300 Hz)
 DEFAULT_SOURCE_MODES = 300
-#: the defaults of :func:`microg.analyze` and ``microg analyze``, SI
+#: the defaults of :func:`microg.analyze` and ``microg analyze``, SI (from :mod:`microg.defaults`)
 DEFAULTS: dict[str, Any] = {
-    "force": "crew-pushoff",
-    "direction": "x",
-    "method": "fem",
-    "plane": "3d",
-    "damping": 0.005,
-    "max_freq_hz": 10.0,
-    "duration_s": 200.0,
-    "dt_s": 0.01,
-    "requirement": "iss",
+    "force": defaults.FORCE,
+    "direction": defaults.DIRECTION,
+    "method": defaults.METHOD,
+    "plane": defaults.PLANE,
+    "damping": defaults.DAMPING,
+    "max_freq_hz": defaults.MAX_FREQ_HZ,
+    "duration_s": defaults.DURATION_S,
+    "dt_s": defaults.DT_S,
+    "requirement": defaults.REQUIREMENT,
     "package_mass_kg": 1000.0 * LB,
     "gravity_gradient": False,
 }

@@ -15,6 +15,7 @@ import sys
 import click
 
 from microg import __version__
+from microg.cli._common import CONTEXT_SETTINGS
 from microg.errors import InputError
 
 __all__ = ["cli", "main"]
@@ -56,7 +57,7 @@ class LazyGroup(click.Group):
         return getattr(importlib.import_module(module_name), attr)
 
 
-@click.group(cls=LazyGroup, context_settings={"help_option_names": ["-h", "--help"]})
+@click.group(cls=LazyGroup, context_settings=CONTEXT_SETTINGS)
 @click.version_option(__version__, prog_name="microg")
 def cli() -> None:
     """Microgravity environment of an orbiting space station.

@@ -14,9 +14,12 @@ from typing import Any
 
 import click
 
+from microg import defaults
 from microg.analysis import DEFAULTS
+from microg.cli._common import Option, given, preset_option, written
 from microg.cli._errors import flag_errors
 from microg.cli.params import Integer, Number, PathType, PositiveFloat
+from microg.units import LB
 
 __all__ = ["analyze", "flag_errors", "write_outputs"]
 
@@ -30,6 +33,7 @@ FLAGS = {
     "method": "--method",
     "plane": "--plane",
     "n": "--elements",
+    "functions": "--functions",
     "n_modes": "--n-modes",
     "max_freq": "--max-freq",
     "duration": "--duration",
@@ -65,104 +69,116 @@ def _weight_to_mass(text: str) -> str:
     return f"{w / G0!r} kg"
 
 
-@click.command()
+#: preset key -> this command's parameter
+PRESET_PARAMS = {k: k for k in ("method", "plane", "damping", "functions")}
+
+
+@click.command(short_help="Microgravity environment of MODEL (the main job).")
 @click.argument("model", required=False, default="ioc")
+@preset_option(PRESET_PARAMS)
 @click.option(
     "--force",
     "forces",
     multiple=True,
+    cls=Option,
+    show_default=f"{DEFAULTS['force']}; none with --sources",
     help="Disturbance: crew-pushoff, crew-pushoff:f0=40lbf,t1=0.5s, a library activity "
-    "(foot-pushoff-max, hand-pushoff-mean, ...) or a CSV file. Repeatable. "
-    f"[default: {DEFAULTS['force']}; none with --sources]",
+    "(foot-pushoff-max, hand-pushoff-mean, ...) or a CSV file. Repeatable.",
 )
 @click.option(
     "--at",
     "at_points",
     multiple=True,
-    help="Named point where each --force acts (one for all, or one per --force). "
-    "[default: the model's first crew point]",
+    cls=Option,
+    show_default="the model's first crew point",
+    help="Named point where each --force acts (one for all, or one per --force).",
 )
 @click.option(
     "--direction",
     "directions",
     multiple=True,
+    cls=Option,
+    show_default=DEFAULTS["direction"],
     help="Force direction: x, y, z, -x, ... or 'dx dy dz' (one for all, or one per --force). "
-    f"A CSV force's own direction wins. [default: {DEFAULTS['direction']}]",
+    "A CSV force's own direction wins.",
 )
 @click.option(
     "--observe",
     multiple=True,
-    help="Named point to assess (repeatable). [default: the model's experiment points]",
+    cls=Option,
+    show_default="the model's experiment points",
+    help="Named point to assess (repeatable).",
 )
 @click.option(
     "--damping",
-    "zeta",
     type=Number(),
-    default=None,
-    help=f"Modal damping ratio of the elastic modes, 0 <= zeta < 1. [default: "
-    f"{DEFAULTS['damping']}]",
+    default=DEFAULTS["damping"],
+    help="Modal damping ratio of the elastic modes, 0 <= zeta < 1.",
 )
 @click.option(
     "--method",
     type=click.Choice(["fem", "ritz"]),
     default=DEFAULTS["method"],
-    show_default=True,
     help="3-D frame finite elements, or assumed modes.",
 )
 @click.option(
     "--plane",
     type=click.Choice(["3d", "xz", "yz"]),
     default=DEFAULTS["plane"],
-    show_default=True,
     help="--method ritz: the 3-D assumed-modes model, or the report's planar model.",
+)
+@click.option(
+    "--functions",
+    type=Integer(1, 40),
+    default=defaults.FUNCTIONS,
+    help="--method ritz: admissible functions per beam and deformation kind.",
 )
 @click.option(
     "--elements",
     type=Integer(1, 10000),
-    default=None,
-    help="Elements per beam (fem) or assumed functions per beam (ritz). [default: 10 / 1]",
+    default=defaults.ELEMENTS,
+    help="--method fem: elements per beam (more where masses and joints cut a beam).",
 )
 @click.option(
     "--n-modes",
     type=Integer(1, 2000),
     default=None,
-    help="Modes solved for frame models (the elastic ones up to --max-freq are used). "
-    "[default: 60]",
+    cls=Option,
+    show_default=f"{defaults.N_MODES} of a sparse model, all of a dense one",
+    help="Modes solved (the elastic ones up to --max-freq are used).",
 )
 @click.option(
     "--gravity-gradient/--free-free",
-    default=False,
-    show_default=True,
-    help="Restrain the rigid rotations by gravity gradient (libration); default free-free.",
+    default=DEFAULTS["gravity_gradient"],
+    help="Restrain the rigid rotations by gravity gradient (libration), or leave the "
+    "structure free-free.",
 )
 @click.option(
     "--max-freq",
-    default=None,
-    help=f"Elastic modes up to this frequency enter the response. [default: "
-    f"{DEFAULTS['max_freq_hz']:g} Hz]",
+    default=f"{DEFAULTS['max_freq_hz']:g} Hz",
+    help="Elastic modes up to this frequency enter the response.",
 )
 @click.option(
     "--duration",
-    default=None,
+    default=f"{DEFAULTS['duration_s']:g} s",
     help="Length of the response record; band RMS is taken over it, so a transient's band RMS "
-    f"falls as the record grows. [default: {DEFAULTS['duration_s']:g} s]",
+    "falls as the record grows.",
 )
-@click.option(
-    "--dt", default=None, help=f"Output sample interval. [default: {DEFAULTS['dt_s']:g} s]"
-)
+@click.option("--dt", default=f"{DEFAULTS['dt_s']:g} s", help="Output sample interval.")
 @click.option(
     "--requirement",
     type=click.Choice(["iss", "ssp41000", "flat"]),
     default=DEFAULTS["requirement"],
-    show_default=True,
     help="ISS vibratory requirement as NASA PIMS codes it, the continuous SSP 41000 curve, or "
     "the report's flat 1e-5 g.",
 )
 @click.option(
     "--package-mass",
     default=None,
+    cls=Option,
+    show_default=f"{DEFAULTS['package_mass_kg'] / LB:g} lb",
     help="Experiment package mass for the isolation advice (a bare number takes the model's "
-    "unit system). [default: 1000 lb]",
+    "unit system).",
 )
 @click.option(
     "--package-weight",
@@ -217,15 +233,16 @@ def analyze(
     at_points: tuple[str, ...],
     directions: tuple[str, ...],
     observe: tuple[str, ...],
-    zeta: float | None,
+    damping: float,
     method: str,
     plane: str,
-    elements: int | None,
+    functions: int,
+    elements: int,
     n_modes: int | None,
     gravity_gradient: bool,
-    max_freq: str | None,
-    duration: str | None,
-    dt: str | None,
+    max_freq: str,
+    duration: str,
+    dt: str,
     requirement: str,
     package_mass: str | None,
     package_weight: str | None,
@@ -250,17 +267,22 @@ def analyze(
     from microg.errors import InputError
 
     _check_out(out_dir)
+    ctx = click.get_current_context()
+    if method == "ritz" and given(ctx, "elements"):
+        raise InputError("applies to --method fem only", where="--elements")
+    if method == "fem" and given(ctx, "functions"):
+        raise InputError("applies to --method ritz only", where="--functions")
     if package_mass is not None and package_weight is not None:
         raise InputError(
             "give --package-mass or --package-weight, not both", where="--package-mass"
         )
     kwargs: dict[str, Any] = {}
+    kwargs["n"] = functions if method == "ritz" else elements
     for key, value in (
-        ("damping", zeta),
+        ("damping", damping),
         ("max_freq", max_freq),
         ("duration", duration),
         ("dt", dt),
-        ("n", elements),
         ("n_modes", n_modes),
         ("absorber_mu", absorber_mu),
     ):
@@ -278,7 +300,8 @@ def analyze(
         for k, v in (("units", units), ("wtmass", wtmass), ("points", points_file))
         if v is not None
     }
-    with flag_errors(FLAGS):
+    flags = {**FLAGS, "n": "--functions" if method == "ritz" else "--elements"}
+    with flag_errors(flags):
         bar = progress_bar(len(stages), "microg analyze", hide=no_progress)
 
         def progress(stage: str) -> None:
@@ -378,4 +401,4 @@ def summary(result: Any, path: Path) -> None:
             click.echo(f"    {name}: {verdict}; {worst}")
     for w in result.warnings:
         click.echo(f"  warning: {w}")
-    click.echo(f"report written to {path / 'report.html'}")
+    written(path)

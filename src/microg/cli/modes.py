@@ -248,4 +248,3 @@ def build_structure(
             station, "ritz", plane=plane or "xz", n=functions, gravity_gradient=True
         )
     return station, discretize(station, "fem", n=elements)
-

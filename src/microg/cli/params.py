@@ -242,8 +242,18 @@ class PathType(click.Path):
         return super().convert(value, param, ctx)
 
 
+def _range_text(rng: click.types._NumberRangeBase) -> str:
+    """The range text of click for the help, empty when the range has no bound."""
+    if rng.min is None and rng.max is None:
+        return ""
+    return click.types._NumberRangeBase._describe_range(rng)
+
+
 class Integer(click.IntRange):
     """click's integer range, in ASCII digits only (no ``"1_0"``, no other scripts' digits)."""
+
+    def _describe_range(self) -> str:
+        return _range_text(self)
 
     def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
         """The integer of ``value``, after the ASCII check, within the range."""
@@ -253,6 +263,9 @@ class Integer(click.IntRange):
 
 class Number(click.FloatRange):
     """click's float range, in ASCII digits only, finite unless a bound says otherwise."""
+
+    def _describe_range(self) -> str:
+        return _range_text(self)
 
     def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
         """The float of ``value``, after the ASCII and finiteness checks, within the range."""

@@ -28,6 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from microg import defaults
 from microg.errors import InputError
 from microg.units import check_limit
 
@@ -73,10 +74,10 @@ class CrewPushoff:
         Naming the parameter (``f0``, ``t1``, ``t13``, ``t14``) that breaks a rule.
     """
 
-    f0: float
-    t1: float = 1.0
-    t13: float = 13.0
-    t14: float = 14.0
+    f0: float = defaults.CREW_F0_N
+    t1: float = defaults.CREW_T1_S
+    t13: float = defaults.CREW_T13_S
+    t14: float = defaults.CREW_T14_S
 
     def __post_init__(self) -> None:
         vals = {"f0": self.f0, "t1": self.t1, "t13": self.t13, "t14": self.t14}

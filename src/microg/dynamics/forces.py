@@ -30,10 +30,11 @@ from pathlib import Path
 
 import numpy as np
 
+from microg import defaults
 from microg._vectors import parse_direction
 from microg.dynamics.crew import CrewPushoff
 from microg.errors import InputError
-from microg.units import LBF, LIMITS, parse_quantity, parse_unit
+from microg.units import LIMITS, parse_quantity, parse_unit
 
 __all__ = [
     "ForceHistory",
@@ -46,11 +47,12 @@ __all__ = [
     "from_csv",
     "activity_library",
     "parse_force_spec",
+    "crew_force",
     "known_force_specs",
 ]
 
 #: the report's push-off magnitude, 25 lbf in newtons (1 lbf = 4.4482216152605 N exactly)
-REPORT_F0_N = 25.0 * LBF
+REPORT_F0_N = defaults.CREW_F0_N
 #: largest force file read, bytes (a million rows of three forces is about 40 MB)
 MAX_CSV_BYTES = 256 * 2**20
 #: longest line of a force file, characters
@@ -313,9 +315,9 @@ def _as_scalar(v: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
 
 def crew_pushoff(
     f0: float = REPORT_F0_N,
-    t1: float = 1.0,
-    t13: float = 13.0,
-    t14: float = 14.0,
+    t1: float = defaults.CREW_T1_S,
+    t13: float = defaults.CREW_T13_S,
+    t14: float = defaults.CREW_T14_S,
     *,
     name: str = "crew-pushoff",
 ) -> ForceHistory:
@@ -839,3 +841,46 @@ def parse_force_spec(
         where=where,
         fix=f"use one of {', '.join(known_force_specs())}, or the path of a CSV file",
     )
+
+
+def crew_force(
+    spec: str | CrewPushoff | ForceHistory | None,
+    *,
+    where: str = "force",
+    bare_units: Mapping[str, str] | None = None,
+) -> CrewPushoff | ForceHistory:
+    """The force of a spec, the push-off kept in its closed form.
+
+    ``crew-pushoff`` and ``crew-pushoff:f0=...,t1=...,t13=...,t14=...`` give a
+    :class:`~microg.dynamics.crew.CrewPushoff` (Eq. 2.16; its modal response is exact,
+    Eqs. 2.17-2.18), every other spec the :class:`ForceHistory` of :func:`parse_force_spec`.
+    The grammar is :func:`parse_force_spec`'s, the one of ``microg analyze --force``.
+
+    Parameters
+    ----------
+    spec : str, CrewPushoff, ForceHistory or None
+        A spec string (None: the report's push-off); a force object passes through.
+    where : str
+        Parameter name for error messages.
+    bare_units : mapping, optional
+        Unit of a bare parameter value per dimension (None: a bare value is refused).
+    """
+    if spec is None:
+        return CrewPushoff()
+    if isinstance(spec, CrewPushoff | ForceHistory):
+        return spec
+    if not isinstance(spec, str):
+        raise InputError(
+            f"expected a force spec string, got {type(spec).__name__}",
+            where=where,
+            fix="give e.g. crew-pushoff:f0=40lbf, a library activity or a CSV file",
+        )
+    head, sep, tail = spec.strip().partition(":")
+    if head.strip().lower() != "crew-pushoff" or _is_file(Path(spec.strip())):
+        return parse_force_spec(spec, where=where, bare_units=bare_units)
+    params = _parse_params(tail, f"{where} {spec.strip()}", bare_units) if sep else {}
+    try:
+        return CrewPushoff(**params)
+    except InputError as exc:
+        shown = f"{where} {spec.strip()}: {exc.where}"
+        raise InputError(exc.what, where=shown, fix=exc.fix) from None

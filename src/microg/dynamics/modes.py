@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+from microg import defaults
 from microg.dynamics.dense import Eigensolution, solve_dense
 from microg.dynamics.rigid import RIGID_TOL
 from microg.structure.structure import Structure
@@ -40,7 +41,7 @@ __all__ = [
 #: choice.  On the shipped IOC frame model (10 elements per beam) the 60th mode is at
 #: ~36 Hz, above the 1/3-octave bands a crew disturbance excites, and 60 modes cost about
 #: 0.1 s.  Dense (assumed-modes) models return all their modes.
-DEFAULT_N_MODES = 60
+DEFAULT_N_MODES = defaults.N_MODES
 #: a participation factor ``|phi_j^T M r_d|`` at most this multiple of its own rounding bound
 #: ``eps |phi_j|^T |M| |r_d|`` is round-off of an exact zero (an elastic mode of a free-free
 #: structure is M-orthogonal to every rigid motion): it is returned as exactly 0.  The factor

@@ -29,6 +29,7 @@ from typing import Any
 
 import numpy as np
 
+from microg import defaults
 from microg._json import finite_list, json_numbers
 from microg._vectors import AXIS_NAMES, parse_direction
 from microg.dynamics.frequency import BandForceSpectrum, Load, band_response, damping_ratios
@@ -160,7 +161,7 @@ def allocate(
     at: str,
     direction: Any,
     requirement: Requirement | None = None,
-    zeta: float | np.ndarray = 0.005,
+    zeta: float | np.ndarray = defaults.DAMPING,
     existing: SourceCatalogue | Sequence[Source] | None = None,
     *,
     duty_weighted: bool = False,

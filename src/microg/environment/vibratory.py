@@ -29,6 +29,7 @@ from typing import Any
 
 import numpy as np
 
+from microg import defaults
 from microg._json import finite_list, finite_or_none, json_numbers
 from microg._vectors import AXIS_NAMES
 from microg.dynamics.frequency import BandResponse, band_response, damping_ratios
@@ -264,7 +265,7 @@ def assess_sources(
     sources: SourceCatalogue | Sequence[Source],
     observe: Sequence[str],
     requirement: Requirement | None = None,
-    zeta: float | np.ndarray = 0.005,
+    zeta: float | np.ndarray = defaults.DAMPING,
     *,
     duty_weighted: bool = False,
     max_modes: int = MAX_MODES_LISTED,

@@ -29,6 +29,7 @@ from typing import Any
 
 import numpy as np
 
+from microg import defaults
 from microg.dynamics.crew import CrewPushoff
 from microg.errors import InputError
 from microg.location.pipeline import (
@@ -36,6 +37,7 @@ from microg.location.pipeline import (
     default_point,
     force_to_dict,
     location_structure,
+    spec_units,
 )
 from microg.location.site import SitePeak, point_peak
 from microg.models.station import Beam, NamedPoint, PointMass, RigidBody, Station
@@ -66,10 +68,11 @@ MAX_POPSIZE = 100
 MAX_MOVABLE = 20
 #: objectives the optimiser accepts (see :class:`~microg.location.site.SitePeak`)
 LAYOUT_MEASURES = ("total", "elastic", "bound")
-#: defaults of :func:`optimize_layout` (and of ``microg optimize``)
+#: defaults of :func:`optimize_layout` (and of ``microg optimize``), from :mod:`microg.defaults`
 DEFAULTS: dict[str, Any] = {
-    "method": "ritz",
-    "plane": "xz",
+    "method": defaults.LAYOUT_METHOD,
+    "plane": defaults.PLANE,
+    "zeta": defaults.DAMPING,
     "measure": "total",
     "seed": 0,
     "maxiter": 60,
@@ -141,6 +144,8 @@ class LayoutResult:
     message : str
     station : Station
         The station with the masses at their optimal positions.
+    zeta : float
+        Modal damping ratio of the elastic modes.
     """
 
     model: str
@@ -163,6 +168,7 @@ class LayoutResult:
     success: bool
     message: str
     station: Station = dataclasses.field(repr=False)
+    zeta: float = DEFAULTS["zeta"]
 
     @property
     def improvement(self) -> float:
@@ -180,6 +186,7 @@ class LayoutResult:
             "method": self.method,
             "plane": self.plane,
             "n": self.n,
+            "zeta": self.zeta,
             "experiment_point": self.experiment,
             "crew_point": self.crew,
             "direction": [float(v) for v in self.direction],
@@ -460,12 +467,11 @@ def move_masses(
 # --------------------------------------------------------------------------- objective
 
 
-def _default_force(force: Any) -> Any:
-    if force is not None:
-        return force
-    from microg.dynamics.forces import REPORT_F0_N
+def _default_force(force: Any, station: Station | None = None) -> Any:
+    """The force of a spec, an object or None (the report's push-off)."""
+    from microg.dynamics.forces import crew_force
 
-    return CrewPushoff(REPORT_F0_N)
+    return crew_force(force, bare_units=spec_units(station))
 
 
 def layout_objective(
@@ -478,6 +484,7 @@ def layout_objective(
     plane: str = DEFAULTS["plane"],
     n: int | None = None,
     direction: str | np.ndarray | None = None,
+    zeta: float = DEFAULTS["zeta"],
 ) -> SitePeak:
     """The peaks at the experiment site for the layout of ``station`` (the reference route).
 
@@ -499,6 +506,8 @@ def layout_objective(
         Functions or elements per beam.
     direction : str or ndarray (3,), optional
         Force direction (default: the plane's lateral axis).
+    zeta : float
+        Modal damping ratio of the elastic modes (0: the exact undamped [A]max per mode).
     """
     from microg.dynamics.modes import solve_modes
 
@@ -508,7 +517,8 @@ def layout_objective(
             known = ", ".join(sorted(structure.points))
             raise InputError(f"unknown point {name!r}", where=where, fix=f"known points: {known}")
     modes = solve_modes(structure)
-    return point_peak(structure, modes, experiment, crew, d, _default_force(force))
+    force = _default_force(force, station)
+    return point_peak(structure, modes, experiment, crew, d, force, zeta=zeta)
 
 
 class _RitzLayout:
@@ -653,6 +663,7 @@ def optimize_layout(
     plane: str = DEFAULTS["plane"],
     n: int | None = None,
     direction: str | np.ndarray | None = None,
+    zeta: float = DEFAULTS["zeta"],
     measure: str = DEFAULTS["measure"],
     seed: int = DEFAULTS["seed"],
     maxiter: int = DEFAULTS["maxiter"],
@@ -693,6 +704,9 @@ def optimize_layout(
         report's model).
     direction : str or ndarray (3,), optional
         Force direction (default: the plane's lateral axis).
+    zeta : float
+        Modal damping ratio of the elastic modes, 0 <= zeta < 1 (default
+        :data:`microg.defaults.DAMPING`; 0: the exact undamped [A]max per mode).
     measure : {"total", "elastic", "bound"}
         The objective.
     seed : int
@@ -723,7 +737,7 @@ def optimize_layout(
         raise InputError(f"unknown method {method!r}", where="method", fix="use ritz or fem")
     experiment = experiment or default_point(station, "experiment", "experiment")
     crew = crew or default_point(station, "crew", "crew")
-    force = _default_force(force)
+    force = _default_force(force, station)
     masses = movable_masses(station, movable, unit_system=unit_system)
     if not masses:
         raise InputError(
@@ -764,10 +778,10 @@ def optimize_layout(
         x = np.clip(np.asarray(x, float), lo, hi)
         if fast is not None:
             s = fast.structure(x)
-            return point_peak(s, solve_modes(s), experiment, crew, d, force)
+            return point_peak(s, solve_modes(s), experiment, crew, d, force, zeta=zeta)
         st = move_masses(station, masses, x, carry=carry_full)
         return layout_objective(
-            st, experiment, crew, force, method=method, plane=plane, n=n, direction=d
+            st, experiment, crew, force, method=method, plane=plane, n=n, direction=d, zeta=zeta
         )
 
     def fun(x: np.ndarray) -> float:
@@ -805,7 +819,7 @@ def optimize_layout(
     best_x = np.clip(best_x, lo, hi)
     st_opt = move_masses(station, masses, best_x, carry=carry_full)
     peak1 = layout_objective(
-        st_opt, experiment, crew, force, method=method, plane=plane, n=n, direction=d
+        st_opt, experiment, crew, force, method=method, plane=plane, n=n, direction=d, zeta=zeta
     )
     peak0_ref = layout_objective(
         move_masses(station, masses, x0, carry=carry_full),
@@ -816,6 +830,7 @@ def optimize_layout(
         plane=plane,
         n=n,
         direction=d,
+        zeta=zeta,
     )
     return LayoutResult(
         model=station.name,

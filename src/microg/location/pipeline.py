@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from microg import defaults
 from microg._vectors import AXES, parse_direction
 from microg.dynamics.crew import CrewPushoff
 from microg.errors import InputError
@@ -40,17 +41,18 @@ __all__ = [
     "force_to_dict",
     "is_imported",
     "locate",
+    "spec_units",
     "location_structure",
 ]
 
 #: the force direction by default: the lateral axis of the report's plane
 LATERAL: dict[str, str] = {"xz": "x", "yz": "y", "3d": "x"}
-#: defaults of :func:`locate` (and of ``microg locate``): the report's planar model
+#: defaults of :func:`locate` (and of ``microg locate``), from :mod:`microg.defaults`
 DEFAULTS: dict[str, Any] = {
-    "method": "ritz",
-    "plane": "xz",
+    "method": defaults.METHOD,
+    "plane": defaults.PLANE,
     "measure": "total",
-    "zeta": 0.0,
+    "zeta": defaults.DAMPING,
     "include_rigid": True,
 }
 
@@ -254,6 +256,14 @@ def _imported_structure(model: Any, crew: str) -> tuple[Structure, np.ndarray | 
     return structure, seg
 
 
+def spec_units(model: Any) -> dict[str, str] | None:
+    """Units of bare values in a force spec: the station's unit system (None otherwise)."""
+    from microg.models.toml import UNIT_SYSTEMS
+
+    system = getattr(model, "unit_system", None)
+    return UNIT_SYSTEMS.get(system) if isinstance(system, str) else None
+
+
 def locate(
     model: Station | Any | str | Path,
     crew: str | None = None,
@@ -293,8 +303,10 @@ def locate(
     crew : str, optional
         Named point (or ``grid:N`` of an imported model) where the force acts (default: the
         model's first point of kind crew).
-    force : CrewPushoff or ForceHistory, optional
-        N (default: the report's push-off, 25 lbf, 1 s, 13 s, 14 s).
+    force : str, CrewPushoff or ForceHistory, optional
+        N, or a spec of :func:`~microg.dynamics.forces.crew_force` (``microg analyze
+        --force``'s grammar; bare values take the model's unit system); default: the
+        report's push-off, 25 lbf, 1 s, 13 s, 14 s.
     direction : str or ndarray (3,), optional
         Force direction (default: the plane's lateral axis, x for xz, y for yz).
     method : {"ritz", "fem"}
@@ -323,7 +335,7 @@ def locate(
     points : str or Path, optional
         Points/options TOML file naming grids of an imported model.
     """
-    from microg.dynamics.forces import REPORT_F0_N
+    from microg.dynamics.forces import crew_force
     from microg.dynamics.modes import solve_modes
 
     mdl = _load(model, units, wtmass, points)
@@ -333,7 +345,7 @@ def locate(
         raise InputError(
             f"unknown measure {measure!r}", where="measure", fix=f"use {', '.join(MEASURES)}"
         )
-    force = force if force is not None else CrewPushoff(REPORT_F0_N)
+    force = crew_force(force, bare_units=spec_units(mdl))
     if is_imported(mdl):
         return _locate_imported(
             mdl, crew, force, direction, plane, n_modes, zeta, include_rigid, on, measure

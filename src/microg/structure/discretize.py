@@ -15,7 +15,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from microg import _args
+from microg import _args, defaults
 from microg.errors import InputError
 from microg.structure.structure import Structure
 
@@ -28,9 +28,9 @@ __all__ = [
 ]
 
 #: frame elements per beam (more where masses, points and joints cut a beam)
-DEFAULT_ELEMENTS = 10
+DEFAULT_ELEMENTS = defaults.ELEMENTS
 #: assumed functions per beam and deformation kind (1 is the report's model)
-DEFAULT_FUNCTIONS = 1
+DEFAULT_FUNCTIONS = defaults.FUNCTIONS
 METHODS = ("fem", "ritz")
 PLANES = ("3d", "xz", "yz")
 

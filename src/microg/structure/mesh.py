@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from microg import defaults
 from microg.errors import InputError
 from microg.models.graph_model import (
     BeamElement,
@@ -49,7 +50,7 @@ TORSION_PENALTY = 1e4
 #: treated as gj = 0 (the rule of docs/model-format.md: 1e-30 lbf*ft^2 behaves like 0)
 GJ_ZERO_FRACTION = 1e-12
 #: default number of elements per beam when neither discretisation option is given
-DEFAULT_ELEMENTS_PER_BEAM = 10
+DEFAULT_ELEMENTS_PER_BEAM = defaults.ELEMENTS
 
 
 @dataclass
