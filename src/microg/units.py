@@ -84,6 +84,7 @@ DIMENSIONS: dict[str, str] = {
     "damping": "N*s/m",
     "gravitational_parameter": "m^3/s^2",
     "force_per_length": "N/m",
+    "angle": "rad",
 }
 
 #: physical limits on input magnitudes, SI, by dimension: an input quantity must satisfy
@@ -108,6 +109,7 @@ LIMITS: dict[str, float] = {
     "damping": 1e12,  # N s/m
     "gravitational_parameter": 1e18,  # m^3/s^2 (the Earth: 3.986e14)
     "force_per_length": 1e7,  # N/m
+    "angle": 1e3,  # rad: an orbit element or attitude angle is within a few turns
 }
 
 #: the smallest non-zero magnitude accepted, per dimension where one matters: a frequency
@@ -385,6 +387,7 @@ _DIMENSION_EXPONENTS: dict[str, tuple[int, int, int]] = {
     "damping": (0, 1, -1),
     "gravitational_parameter": (3, 0, -2),
     "force_per_length": (0, 1, -2),
+    "angle": (0, 0, 0),
 }
 
 
@@ -409,6 +412,8 @@ def _builtin_conversion(canonical: str, dimension: str) -> _Conversion | None:
             f"is not {article} {nice} ({paren})",
             f"use a unit of {nice}, e.g. {DIMENSIONS[dimension] or 'a plain number'}",
         )
+    if dimension == "angle" and radian != 1:
+        raise _WrongDimensionError("is not an angle", "use deg or rad, e.g. '51.6 deg'")
     if dimension == "angular_frequency" and not radian and hertz:
         factor *= 2.0 * math.pi
     elif dimension == "frequency" and radian:

@@ -19,6 +19,7 @@ from microg.analysis import DEFAULTS
 from microg.cli._common import Option, given, preset_option, written
 from microg.cli._errors import flag_errors
 from microg.cli.params import Integer, Number, PathType, PositiveFloat
+from microg.structure.ritz import MAX_FUNCTIONS
 from microg.units import LB
 
 __all__ = ["analyze", "flag_errors", "write_outputs"]
@@ -129,7 +130,7 @@ PRESET_PARAMS = {k: k for k in ("method", "plane", "damping", "functions")}
 )
 @click.option(
     "--functions",
-    type=Integer(1, 40),
+    type=Integer(1, MAX_FUNCTIONS),
     default=defaults.FUNCTIONS,
     help="--method ritz: admissible functions per beam and deformation kind.",
 )

@@ -10,6 +10,7 @@ from typing import Any
 
 import click
 
+from microg.cli._common import num, written
 from microg.cli.params import PathType, QuantityType
 
 __all__ = ["assess", "merge_assessments", "run_assessment"]
@@ -148,7 +149,7 @@ def assess(
         for r in results:
             _summary(r)
         if out_dir is not None:
-            click.echo(f"written to {path}")
+            written(path)
 
 
 def merge_assessments(results: list[dict[str, Any]]) -> dict[str, Any]:
@@ -224,7 +225,7 @@ def run_assessment(
     if record.duration_s < interval_s and not explicit_interval:
         length = record.duration_s
         warnings.append(
-            f"the record ({record.duration_s:.6g} s) is shorter than the default "
+            f"the record ({num(record.duration_s)} s) is shorter than the default "
             f"{interval_s:g}-s interval: the interval products take it as one interval"
         )
     iv = interval_products(
@@ -293,14 +294,14 @@ def _summary(result: dict[str, Any]) -> None:
     cut = f", cutoff {rec.cutoff_hz:g} Hz" if rec.cutoff_hz else ""
     click.echo(
         f"{rec.path}: {key} ({rec.format.upper()}, {rec.sample_rate_hz:g} Hz{cut}), "
-        f"{rec.duration_s:.6g} s"
+        f"{num(rec.duration_s)} s"
     )
-    mean = ", ".join(f"{n} {v * ug:.4g}" for n, v in zip(a.axes, a.mean_accel_g_axis, strict=True))
+    mean = ", ".join(f"{n} {num(v * ug)}" for n, v in zip(a.axes, a.mean_accel_g_axis, strict=True))
     click.echo(f"  mean (quasi-steady or sensor bias, removed before the bands): {mean} micro-g")
     verdict = "complies" if a.complies else "DOES NOT COMPLY"
     vr = a.verdict_range_hz
     cover = (
-        f"bands {vr[0]:.4g}-{vr[1]:.4g} Hz judged ({int(a.third_octave.judged.sum())} of "
+        f"bands {num(vr[0])}-{num(vr[1])} Hz judged ({int(a.third_octave.judged.sum())} of "
         f"{a.third_octave.center_hz.size})"
         if vr
         else "no band judged"
@@ -309,19 +310,19 @@ def _summary(result: dict[str, Any]) -> None:
     wb = a.worst_band
     if wb is not None:
         click.echo(
-            f"  worst band {wb.center_hz:.4g} Hz ({wb.axis}): {wb.rms_g * ug:.3g} micro-g RMS, "
-            f"limit {wb.limit_g * ug:.3g}, margin {wb.margin:.3g}"
+            f"  worst band {num(wb.center_hz)} Hz ({wb.axis}): {num(wb.rms_g * ug)} micro-g RMS, "
+            f"limit {num(wb.limit_g * ug)}, margin {num(wb.margin)}"
         )
     b = iv.bands
     at99 = b.complies_at(99.0) if 99.0 in b.percentiles and b.resolved.any() else None
     p99 = "" if at99 is None else f"; 99th percentile within the limit: {'yes' if at99 else 'NO'}"
-    click.echo(f"  intervals: {b.t_start_s.size} x {b.interval_s:.6g} s{p99}")
+    click.echo(f"  intervals: {b.t_start_s.size} x {num(b.interval_s)} s{p99}")
     pb = a.integrated_pims
     if pb is not None:
         worst = max(pb.max_mps) / G0 * ug
         click.echo(
             f"  integrated acceleration (PIMS, {pb.n_blocks} blocks of {pb.window_s:g} s): "
-            f"max {worst:.3g} micro-g s"
+            f"max {num(worst)} micro-g s"
         )
     if a.transient is not None:
         tag = "" if a.transient.verified else " (unverified values: reported, not in the verdict)"

@@ -15,6 +15,7 @@ import click
 import numpy as np
 
 from microg._io import dumps
+from microg.cli._common import num, written
 from microg.cli.params import BandType, PathType, PositiveFloat, QuantityType, RangeType
 from microg.units import LBF
 
@@ -103,7 +104,7 @@ def curve(k: float, mu: float, zeta: float, r2: tuple[float, float, int], as_jso
     base = accel_magnification_no_absorber(np.sqrt(r2v))
     click.echo(
         f"k = {k:g}, mu = {mu:g}, zeta = {zeta:g}, f = omega_a/omega_n = "
-        f"{float(absorber_tuning_ratio(k, mu)):.4g}"
+        f"{num(float(absorber_tuning_ratio(k, mu)))}"
     )
     click.echo(f"{'r^2':>10} {'M_a':>12} {'no absorber':>12}")
     for x, m, b in zip(r2v, ma, base, strict=True):
@@ -254,22 +255,22 @@ def design(
     if as_json:
         click.echo(dumps(res.to_dict()))
         return
-    click.echo(f"package mass          {res.mass:.6g} kg ({res.mass * G0 * _LBF_PER_N:.6g} lbf)")
-    click.echo(f"disturbance band      {band[0]:.6g} .. {band[1]:.6g} rad/s")
+    click.echo(f"package mass          {num(res.mass)} kg ({num(res.mass * G0 * _LBF_PER_N)} lbf)")
+    click.echo(f"disturbance band      {num(band[0])} .. {num(band[1])} rad/s")
     click.echo(f"target M_a            <= {target:g}")
-    click.echo(f"largest k1            {res.k1:.6g} N/m = {res.k1_lbf_per_in:.6g} lbf/in")
-    click.echo(f"mount natural freq.   {res.omega_n:.6g} rad/s = {res.freq_hz_n:.6g} Hz")
-    click.echo(f"r over the band       {res.r_band[0]:.6g} .. {res.r_band[1]:.6g}")
-    click.echo(f"achieved max M_a      {res.achieved_Ma:.6g}")
-    click.echo(f"sag under 1 g         {res.sag_1g:.6g} m (ground test)")
+    click.echo(f"largest k1            {num(res.k1)} N/m = {num(res.k1_lbf_per_in)} lbf/in")
+    click.echo(f"mount natural freq.   {num(res.omega_n)} rad/s = {num(res.freq_hz_n)} Hz")
+    click.echo(f"r over the band       {num(res.r_band[0])} .. {num(res.r_band[1])}")
+    click.echo(f"achieved max M_a      {num(res.achieved_Ma)}")
+    click.echo(f"sag under 1 g         {num(res.sag_1g)} m (ground test)")
     if res.mu is not None:
         click.echo(
-            f"absorber              mu = {res.mu:g}, k = {res.k:.6g}, zeta = {res.zeta:.6g},"
-            f" f = {res.f:.6g}"
+            f"absorber              mu = {res.mu:g}, k = {num(res.k)}, zeta = {num(res.zeta)},"
+            f" f = {num(res.f)}"
         )
         click.echo(
-            f"                      m2 = {res.m2:.6g} kg, k2 = {res.k2:.6g} N/m, "
-            f"c = {res.c:.6g} N s/m"
+            f"                      m2 = {num(res.m2)} kg, k2 = {num(res.k2)} N/m, "
+            f"c = {num(res.c)} N s/m"
         )
 
 
@@ -330,7 +331,7 @@ def figure8(out: str, r2_max: float) -> None:
         make(out, r2_max=r2_max)
     except OSError as exc:
         raise InputError(f"cannot write {out}: {exc.strerror or exc}", where="--out") from None
-    click.echo(f"wrote {out}")
+    written(out)
 
 
 def _register_active() -> None:

@@ -12,6 +12,7 @@ from typing import Any
 import click
 
 from microg._io import dumps
+from microg.cli._common import num, written
 from microg.cli.params import PathType, PositiveFloat, QuantityType
 from microg.errors import InputError
 
@@ -260,7 +261,7 @@ def active(
     att = res.attenuation_at(0.1)
     click.echo(
         "attenuation at 0.1 Hz: "
-        + ", ".join(f"{a} {v:.3g}x" for a, v in zip("xyz", att, strict=True))
+        + ", ".join(f"{a} {num(v)}x" for a, v in zip("xyz", att, strict=True))
     )
     for m in res.margins:
         click.echo(
@@ -269,10 +270,10 @@ def active(
     if res.time is not None:
         tm = res.time
         click.echo(
-            f"at {tm.point}: complies {res.complies}; stroke {tm.peak_stroke[:3].max():.3g} m, "
-            f"force {tm.peak_force[:3].max():.3g} N"
+            f"at {tm.point}: complies {res.complies}; stroke {num(tm.peak_stroke[:3].max())} m, "
+            f"force {num(tm.peak_force[:3].max())} N"
         )
     for n in res.notes:
         click.echo(f"  - {n}")
     if out_dir is not None:
-        click.echo(f"wrote {out_dir}")
+        written(out_dir)

@@ -19,21 +19,24 @@ from typing import Any
 import click
 import numpy as np
 
+from microg import defaults
 from microg._io import dumps
-from microg.cli.params import Integer, PathType, PositiveFloat, QuantityType
+from microg.cli._common import Option, given, num, preset_option, written
+from microg.cli.params import Integer, Number, PathType, PositiveFloat
 from microg.errors import InputError
 from microg.location.amap import DEFAULTS as LOCATE_DEFAULTS
 from microg.location.layout import DEFAULTS as LAYOUT_DEFAULTS
 from microg.location.layout import MAX_GENERATIONS
+from microg.structure.ritz import MAX_FUNCTIONS
 from microg.units import FT, G0
 
 __all__ = ["locate", "optimize", "MovableType", "CarryType", "FLAGS"]
 
 #: library parameter names -> options of these commands
 FLAGS: dict[str, str] = {
-    "crew": "--crew",
-    "crew_point": "--crew",
-    "experiment": "--experiment",
+    "crew": "--at",
+    "crew_point": "--at",
+    "experiment": "--observe",
     "movable": "--movable",
     "carry": "--carry",
     "direction": "--direction",
@@ -45,11 +48,7 @@ FLAGS: dict[str, str] = {
     "n_modes": "--n-modes",
     "maxiter": "--maxiter",
     "seed": "--seed",
-    "force": "--f0",
-    "f0": "--f0",
-    "t1": "--t1",
-    "t13": "--t13",
-    "t14": "--t14",
+    "force": "--force",
     "units": "--units",
     "wtmass": "--wtmass",
     "points": "--points",
@@ -112,46 +111,45 @@ class CarryType(click.ParamType):
         return (point.strip(), mass.strip())
 
 
-def _force_options(f: Callable[..., Any]) -> Callable[..., Any]:
-    opts = [
-        click.option(
-            "--f0",
-            type=QuantityType("force", "lbf"),
-            default="25 lbf",
-            show_default=True,
-            help="Crew force peak (Eq. 2.16; bare number: lbf).",
-        ),
-        click.option(
-            "--t1",
-            type=QuantityType("time", "s", minimum=0.0, strict=True),
-            default="1 s",
-            show_default=True,
-            help="Push-off ramp duration (bare number: s).",
-        ),
-        click.option(
-            "--t13",
-            type=QuantityType("time", "s"),
-            default="13 s",
-            show_default=True,
-            help="Landing start, >= t1 (bare number: s).",
-        ),
-        click.option(
-            "--t14",
-            type=QuantityType("time", "s"),
-            default="14 s",
-            show_default=True,
-            help="Landing end, > t13 (bare number: s).",
-        ),
-    ]
-    for o in reversed(opts):
-        f = o(f)
-    return f
+#: preset key -> the parameter of ``locate`` and ``optimize``
+PRESET_PARAMS = {k: k for k in ("method", "plane", "damping", "functions")}
 
 
-def _crew(f0: float, t1: float, t13: float, t14: float) -> Any:
-    from microg.dynamics.crew import CrewPushoff
+def _push_options(what: str) -> Callable[[Any], Any]:
+    """``--at``, ``--force`` and ``--direction``, as in ``microg analyze``."""
 
-    return CrewPushoff.checked(f0, t1, t13, t14)
+    def decorate(f: Callable[..., Any]) -> Callable[..., Any]:
+        opts = [
+            click.option(
+                "--at",
+                "at_point",
+                default=None,
+                cls=Option,
+                show_default="the model's first crew point",
+                help=f"Named point where the --force acts{what}.",
+            ),
+            click.option(
+                "--force",
+                "force",
+                default=defaults.FORCE,
+                help="Disturbance, as in microg analyze: crew-pushoff, "
+                "crew-pushoff:f0=40lbf,t1=0.5s (bare numbers in the model's unit system), a "
+                "library activity (foot-pushoff-max, ...) or a CSV file.",
+            ),
+            click.option(
+                "--direction",
+                default=None,
+                cls=Option,
+                show_default="x (y for --plane yz)",
+                help="Force direction: x, y, z, -x, ... or 'dx dy dz'; a planar model moves "
+                "along its lateral axis only.",
+            ),
+        ]
+        for o in reversed(opts):
+            f = o(f)
+        return f
+
+    return decorate
 
 
 def _check_writable(path: Path, where: str) -> None:
@@ -212,48 +210,49 @@ def _unit_system(station: Any, model: str) -> str | None:
     return str(units) if units else None
 
 
-@click.command()
+@click.command(short_help="Where to put the laboratory: the acceleration map.")
 @click.argument("model")
+@preset_option(PRESET_PARAMS)
+@_push_options("")
 @click.option(
-    "--crew",
-    "crew_point",
-    default=None,
-    help="Named point where the crew pushes (default: the model's first crew point).",
-)
-@click.option(
-    "--direction",
-    default=None,
-    help="Force direction: x, y, z, -x... or 'X Y Z' (default: the plane's lateral axis).",
+    "--method",
+    type=click.Choice(["fem", "ritz"]),
+    default=LOCATE_DEFAULTS["method"],
+    help="3-D frame finite elements, or assumed modes (stations only).",
 )
 @click.option(
     "--plane",
-    type=click.Choice(["xz", "yz", "3d"]),
+    type=click.Choice(["3d", "xz", "yz"]),
     default=LOCATE_DEFAULTS["plane"],
-    show_default=True,
-    help="Ritz: the planar model, or 3d; FE: sets the default direction only.",
+    help="--method ritz: the 3-D assumed-modes model, or the report's planar model; otherwise "
+    "it sets the default direction only.",
 )
 @click.option(
-    "--method",
-    type=click.Choice(["ritz", "fem"]),
-    default=LOCATE_DEFAULTS["method"],
-    show_default=True,
+    "--functions",
+    type=Integer(1, MAX_FUNCTIONS),
+    default=defaults.FUNCTIONS,
+    help="--method ritz: admissible functions per beam and deformation kind.",
 )
-@click.option("--functions", type=Integer(1, 40), default=None, help="Ritz: per beam (1).")
-@click.option("--elements", type=Integer(1, 2000), default=None, help="FE: per beam (10).")
+@click.option(
+    "--elements",
+    type=Integer(1, 2000),
+    default=defaults.ELEMENTS,
+    help="--method fem: elements per beam.",
+)
 @click.option(
     "--n-modes",
     "n_modes",
     type=Integer(min=1),
     default=None,
-    help="Modes used (default: the solver's).",
+    cls=Option,
+    show_default=f"{defaults.N_MODES} of a sparse model, all of a dense one",
+    help="Lowest modes used.",
 )
-@_force_options
 @click.option(
     "--damping",
-    type=PositiveFloat(0.0, strict=False),
+    type=Number(),
     default=LOCATE_DEFAULTS["zeta"],
-    show_default=True,
-    help="Modal damping ratio zeta, 0 <= zeta < 1 (0: exact [A]max per mode).",
+    help="Modal damping ratio of the elastic modes, 0 <= zeta < 1 (0: the exact [A]max per mode).",
 )
 @click.option("--no-rigid", "no_rigid", is_flag=True, help="Leave out the rigid-body modes.")
 @click.option(
@@ -296,17 +295,14 @@ def _unit_system(station: Any, model: str) -> str | None:
 )
 def locate(
     model: str,
-    crew_point: str | None,
+    at_point: str | None,
+    force: str,
     direction: str | None,
-    plane: str,
     method: str,
-    functions: int | None,
-    elements: int | None,
+    plane: str,
+    functions: int,
+    elements: int,
     n_modes: int | None,
-    f0: float,
-    t1: float,
-    t13: float,
-    t14: float,
     damping: float,
     no_rigid: bool,
     component: str | None,
@@ -327,14 +323,15 @@ def locate(
     a UFF .unv/.uff, microg's own .npz modal-model file (mapped over every grid, named
     points added as 'points': --on points picks the quietest of them), or a .bdf/.dat deck
     (solved by microg's frame FE, nodes of the fundamental along its straight chains of
-    beams and rods).  --crew accepts grid:N for imported models; --method, --functions and
+    beams and rods).  --at accepts grid:N for imported models; --method, --functions and
     --elements apply to stations only.
     """
     from microg.location.amap import locate as run_locate
 
-    if method == "ritz" and elements is not None:
+    ctx = click.get_current_context()
+    if method == "ritz" and given(ctx, "elements"):
         raise InputError("applies to --method fem only", where="--elements")
-    if method == "fem" and functions is not None:
+    if method == "fem" and given(ctx, "functions"):
         raise InputError("applies to --method ritz only", where="--functions")
     if out_dir is not None:
         _check_writable(out_dir, "--out")
@@ -342,8 +339,8 @@ def locate(
     with _as_flags({"n": n_flag}):
         result = run_locate(
             model,
-            crew_point,
-            force=_crew(f0, t1, t13, t14),
+            at_point,
+            force=force,
             direction=direction,
             method=method,
             plane=plane,
@@ -369,7 +366,7 @@ def locate(
         return
     _summary(result)
     if out_dir is not None:
-        click.echo(f"map written to {path / 'map.json'} and {path / 'map.png'}")
+        written(path)
 
 
 def _summary(result: Any) -> None:
@@ -379,48 +376,46 @@ def _summary(result: Any) -> None:
     click.echo(
         f"{label} ({amap.method}{where}): push-off at {amap.crew_point!r} along "
         f"{'xyz'[int(np.argmax(np.abs(amap.direction)))]}, {amap.n_samples} samples, "
-        f"window {amap.window[0]:g}-{amap.window[1]:.4g} s"
+        f"window {amap.window[0]:g}-{num(amap.window[1])} s"
     )
     if amap.fundamental is not None:
-        click.echo(f"fundamental elastic mode: omega = {amap.omega[amap.fundamental]:.6g} rad/s")
+        click.echo(f"fundamental elastic mode: omega = {num(amap.omega[amap.fundamental])} rad/s")
     for n in amap.nodes:
         p = n.position
         click.echo(
-            f"  node on {n.component}: ({p[0]:.4g}, {p[1]:.4g}, {p[2]:.4g}) m"
-            f" = ({p[0] / FT:.4g}, {p[1] / FT:.4g}, {p[2] / FT:.4g}) ft"
+            f"  node on {n.component}: ({num(p[0])}, {num(p[1])}, {num(p[2])}) m"
+            f" = ({num(p[0] / FT)}, {num(p[1] / FT)}, {num(p[2] / FT)}) ft"
         )
     for comp in dict.fromkeys(amap.component.tolist()):
         sel = amap.component == comp
         tot = amap.total_peak[sel] * g
         el = amap.elastic_peak[sel] * g
         click.echo(
-            f"  {comp:>12}: total peak {tot.min():.3g} .. {tot.max():.3g} g, "
-            f"elastic {el.min():.3g} .. {el.max():.3g} g"
+            f"  {comp:>12}: total peak {num(tot.min())} .. {num(tot.max())} g, "
+            f"elastic {num(el.min())} .. {num(el.max())} g"
         )
     p = loc.position
     name = f" {loc.label}" if loc.label else ""
     click.echo(
         f"best location ({loc.measure}) on {loc.component}{name}: "
-        f"({p[0]:.4g}, {p[1]:.4g}, {p[2]:.4g}) m = z {p[2] / FT:.4g} ft, {loc.peak_g:.3g} g"
+        f"({num(p[0])}, {num(p[1])}, {num(p[2])}) m = z {num(p[2] / FT)} ft, {num(loc.peak_g)} g"
     )
     for w in result.warnings:
         click.echo(f"warning: {w}")
 
 
-@click.command()
+@click.command(short_help="Move the movable masses to quieten the experiment site.")
 @click.argument("model")
+@preset_option(PRESET_PARAMS)
 @click.option(
-    "--experiment",
-    "experiment_point",
+    "--observe",
+    "observe",
     default=None,
-    help="Named experiment site (default: the model's first experiment point).",
+    cls=Option,
+    show_default="the model's first experiment point",
+    help="Named experiment site whose peak is minimised.",
 )
-@click.option(
-    "--crew",
-    "crew_point",
-    default=None,
-    help="Named point where the crew pushes (default: the model's first crew point).",
-)
+@_push_options("")
 @click.option(
     "--movable",
     "movable",
@@ -438,17 +433,22 @@ def _summary(result: Any) -> None:
 )
 @click.option(
     "--plane",
-    type=click.Choice(["xz", "yz"]),
+    type=click.Choice(["3d", "xz", "yz"]),
     default=LAYOUT_DEFAULTS["plane"],
-    show_default=True,
+    help="The 3-D assumed-modes model, or the report's planar model.",
 )
 @click.option(
     "--functions",
-    type=Integer(1, 40),
-    default=None,
-    help="Admissible functions per beam (default 1, the report's model).",
+    type=Integer(1, MAX_FUNCTIONS),
+    default=defaults.FUNCTIONS,
+    help="Admissible functions per beam and deformation kind.",
 )
-@_force_options
+@click.option(
+    "--damping",
+    type=Number(),
+    default=LAYOUT_DEFAULTS["zeta"],
+    help="Modal damping ratio of the elastic modes, 0 <= zeta < 1 (0: the exact [A]max per mode).",
+)
 @click.option(
     "--measure",
     type=click.Choice(["total", "elastic", "bound"]),
@@ -470,16 +470,15 @@ def _summary(result: Any) -> None:
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
 def optimize(
     model: str,
-    experiment_point: str | None,
-    crew_point: str | None,
+    observe: str | None,
+    at_point: str | None,
+    force: str,
+    direction: str | None,
     movable: tuple[tuple[str, str, str], ...],
     carry: tuple[tuple[str, str], ...],
     plane: str,
-    functions: int | None,
-    f0: float,
-    t1: float,
-    t13: float,
-    t14: float,
+    functions: int,
+    damping: float,
     measure: str,
     seed: int,
     maxiter: int,
@@ -489,14 +488,13 @@ def optimize(
     """Move MODEL's movable masses to minimise the crew-induced peak at the experiment site.
 
     Objective (report conclusion 9): the site's peak acceleration over time, rigid-body
-    modes included (--measure), on the assumed-modes model of each trial layout.
+    modes included (--measure), on the assumed-modes model of each trial layout (re-assembled
+    incrementally; a frame model would be re-meshed and re-solved for every trial).
     """
     from microg.cli._progress import progress_bar
     from microg.location.layout import optimize_layout
     from microg.models.toml import load_station
 
-    with _as_flags():
-        crew = _crew(f0, t1, t13, t14)
     station = load_station(model)
     overrides = {name: (lo, hi) for name, lo, hi in movable}
     bar = progress_bar(maxiter, "microg optimize", hide=no_progress, unit="gen")
@@ -508,13 +506,15 @@ def optimize(
         with _as_flags({"n": "--functions"}):
             res = optimize_layout(
                 station,
-                experiment_point,
-                crew_point,
-                crew,
+                observe,
+                at_point,
+                force,
                 movable=overrides,
                 carry=dict(carry),
                 plane=plane,
                 n=functions,
+                direction=direction,
+                zeta=damping,
                 measure=measure,
                 seed=seed,
                 maxiter=maxiter,
@@ -536,23 +536,25 @@ def _optimize_summary(res: Any) -> None:
     click.echo(
         f"{res.model}: peak at {res.experiment!r} from a push-off at {res.crew!r} "
         f"({res.method} {res.plane}, {res.n or DEFAULT_FUNCTIONS} function(s) per beam, "
+        f"damping {num(res.zeta)}, "
         f"{res.n_evaluations} evaluations)"
     )
     for mm, x0, x1 in zip(res.masses, res.initial, res.optimal, strict=True):
         coord = "z" if mm.kind == "body" else "s"
         click.echo(
-            f"  {mm.key}: {coord} {x0:.4g} m ({x0 / FT:.4g} ft) -> {x1:.4g} m ({x1 / FT:.4g} ft)"
-            f"  [range {mm.bounds[0]:.4g} .. {mm.bounds[1]:.4g} m]"
+            f"  {mm.key}: {coord} {num(x0)} m ({num(x0 / FT)} ft) -> "
+            f"{num(x1)} m ({num(x1 / FT)} ft)"
+            f"  [range {num(mm.bounds[0])} .. {num(mm.bounds[1])} m]"
         )
     a, b = res.initial_peak, res.optimal_peak
     gain = res.improvement
-    gain_text = f"x{gain:.3g} lower" if np.isfinite(gain) else "to zero"
+    gain_text = f"x{num(gain)} lower" if np.isfinite(gain) else "to zero"
     click.echo(
-        f"{res.measure} peak (objective): {res.objective_initial * g:.4g} g -> "
-        f"{res.objective_optimal * g:.4g} g ({gain_text})"
+        f"{res.measure} peak (objective): {num(res.objective_initial * g)} g -> "
+        f"{num(res.objective_optimal * g)} g ({gain_text})"
     )
     click.echo(
-        f"  total {a.total_mps2 * g:.4g} -> {b.total_mps2 * g:.4g} g; its parts (peaks over "
-        f"time, not additive): rigid-body {a.rigid_mps2 * g:.4g} -> {b.rigid_mps2 * g:.4g} g, "
-        f"elastic {a.elastic_mps2 * g:.4g} -> {b.elastic_mps2 * g:.4g} g"
+        f"  total {num(a.total_mps2 * g)} -> {num(b.total_mps2 * g)} g; its parts (peaks over "
+        f"time, not additive): rigid-body {num(a.rigid_mps2 * g)} -> {num(b.rigid_mps2 * g)} g, "
+        f"elastic {num(a.elastic_mps2 * g)} -> {num(b.elastic_mps2 * g)} g"
     )

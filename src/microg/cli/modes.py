@@ -12,7 +12,10 @@ from typing import Any
 
 import click
 
+from microg import defaults
+from microg.cli._common import Option, given, num, preset_option, written
 from microg.cli.params import Integer, PathType, PositiveFloat
+from microg.structure.ritz import MAX_FUNCTIONS
 
 __all__ = ["modes"]
 
@@ -30,9 +33,7 @@ FLAGS = {
 
 
 def _default_modes() -> int:
-    from microg.dynamics.modes import DEFAULT_N_MODES
-
-    return DEFAULT_N_MODES
+    return defaults.N_MODES
 
 
 def _effective_percent(m: Any) -> dict[str, Any]:
@@ -40,50 +41,49 @@ def _effective_percent(m: Any) -> dict[str, Any]:
     return {d: 100.0 * v for d, v in m.effective_mass_fraction.items()}
 
 
-@click.command()
+@click.command(short_help="Natural frequencies, modal and effective masses of MODEL.")
 @click.argument("model")
+@preset_option({k: k for k in ("method", "plane", "functions")})
 @click.option(
     "--method",
     type=click.Choice(["fem", "ritz"]),
-    default="fem",
-    show_default=True,
+    default=defaults.METHOD,
     help="3-D frame finite elements, or assumed modes (the report's method). Imported modal "
     "models ignore it.",
 )
 @click.option(
     "--plane",
-    type=click.Choice(["xz", "yz", "3d"]),
-    default="3d",
-    show_default=True,
+    type=click.Choice(["3d", "xz", "yz"]),
+    default=defaults.PLANE,
     help="Ritz: the report's planar model in this plane, or the 3-D assumed-modes model. "
     "FE: report only the modes with more than half their kinetic energy in this plane.",
 )
 @click.option(
     "--functions",
-    type=Integer(1, 16),
-    default=None,
-    help="Ritz: admissible functions per beam and deformation kind (default 1).",
+    type=Integer(1, MAX_FUNCTIONS),
+    default=defaults.FUNCTIONS,
+    help="--method ritz: admissible functions per beam and deformation kind.",
 )
 @click.option(
     "--elements",
     type=Integer(1, 10000),
-    default=None,
-    help="FE: minimum elements per beam (default 10; more where masses and joints cut it).",
+    default=defaults.ELEMENTS,
+    help="--method fem: minimum elements per beam (more where masses and joints cut it).",
 )
 @click.option(
     "--n-modes",
     "n_modes",
     type=Integer(1, 2000),
     default=None,
-    help="Number of lowest modes, at least the rigid-body ones (default: all of a dense "
-    "model, 60 of a sparse one).",
+    cls=Option,
+    show_default=f"{defaults.N_MODES} of a sparse model, all of a dense one",
+    help="Number of lowest modes, at least the rigid-body ones.",
 )
 @click.option(
     "--gravity-gradient/--free-free",
     default=False,
-    show_default=True,
     help="Restrain the rigid rotations by gravity gradient (libration), as the report's "
-    "Appendix B does; the default is the free-free structure.",
+    "Appendix B does, or leave the structure free-free.",
 )
 @click.option("--units", default=None, help="Units of a NASTRAN/UFF file: 'LENGTH,FORCE,TIME'.")
 @click.option(
@@ -114,15 +114,16 @@ def _effective_percent(m: Any) -> dict[str, Any]:
 @click.option(
     "--constrained",
     is_flag=True,
-    help="A NASTRAN deck or frame model: apply its SPCs (the clamped run); default free-free.",
+    help="A NASTRAN deck or frame model: apply its SPCs (the clamped run) instead of the "
+    "free-free structure.",
 )
 @click.option("--json", "as_json", is_flag=True, help="Print the modes as JSON.")
 def modes(
     model: str,
     method: str,
     plane: str,
-    functions: int | None,
-    elements: int | None,
+    functions: int,
+    elements: int,
     n_modes: int | None,
     gravity_gradient: bool,
     units: str | None,
@@ -148,14 +149,15 @@ def modes(
     from microg.errors import InputError
     from microg.structure.discretize import discretize
 
-    if method == "ritz" and elements is not None:
+    ctx = click.get_current_context()
+    if method == "ritz" and given(ctx, "elements"):
         raise InputError("applies to --method fem only", where="--elements")
-    if method == "fem" and functions is not None:
+    if method == "fem" and given(ctx, "functions"):
         raise InputError("applies to --method ritz only", where="--functions")
     if uff_out is not None:  # before any work: a file that cannot be written is bad input
         uff_out = check_writable(uff_out, where="--uff", directory=False)
-    given = (("units", units), ("wtmass", wtmass), ("points", points), ("subcase", subcase))
-    options = {k: v for k, v in given if v is not None}
+    reader = (("units", units), ("wtmass", wtmass), ("points", points), ("subcase", subcase))
+    options = {k: v for k, v in reader if v is not None}
     with flag_errors(FLAGS):
         mdl = microg.load_model(model, **options)
         fem_plane = method == "fem" and plane != "3d"
@@ -202,7 +204,7 @@ def modes(
     if replaced and replaced.get("count"):
         click.echo(
             f"  {replaced['count']} of the file's modes replaced by exact rigid-body modes "
-            f"(largest file frequency among them {replaced.get('max_file_freq_hz', 0):.3g} Hz)"
+            f"(largest file frequency among them {num(replaced.get('max_file_freq_hz', 0))} Hz)"
         )
     head = f"{'#':>3} {'omega (rad/s)':>14} {'f (Hz)':>11} {'rigid':>5} {'modal mass (kg)':>16}"
     head += "".join(f" {'eff ' + d + ' %':>9}" for d in dirs)
@@ -212,21 +214,23 @@ def modes(
         kind = "yes" if m.rigid[j] else ("UNST" if unstable[j] else "no")
         if unstable[j]:  # an imaginary frequency: omega = i * growth rate
             rate = float(np.asarray(m.growth_rate, float)[j])
-            om, fr = f"{rate:.6g}i", f"{rate / (2 * np.pi):.5g}i"
+            om, fr = f"{num(rate)}i", f"{num(rate / (2 * np.pi))}i"
         else:
-            om, fr = f"{m.omega[j]:.6g}", f"{m.freq_hz[j]:.5g}"
-        row = f"{j + 1:>3} {om:>14} {fr:>11} {kind:>5} {m.modal_mass[j]:>16.6g}"
+            om, fr = f"{num(m.omega[j])}", f"{num(m.freq_hz[j])}"
+        row = f"{j + 1:>3} {om:>14} {fr:>11} {kind:>5} {num(m.modal_mass[j]):>16}"
         row += "".join(f" {_pct(pct[d][j]):>9}" for d in dirs)
         click.echo(row)
     for note in m.notes:
         click.echo(f"  note: {note}")
+    if uff_out is not None:
+        written(uff_out)
     for warning in structure.meta.get("warnings", ()):
         click.echo(f"  warning: {warning}")
 
 
 def _pct(v: float) -> str:
     """A percentage; below 1e-9 % it is the rounding of M-orthogonality, shown as 0."""
-    return "0" if abs(v) < 1e-9 else f"{v:.3g}"
+    return "0" if abs(v) < 1e-9 else f"{num(v)}"
 
 
 # ---- transitional: cli/locate.py still imports these two; removed when it moves to the API

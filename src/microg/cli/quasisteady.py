@@ -6,13 +6,17 @@ name its parameters; :data:`FLAGS` maps them back to the options.
 
 from __future__ import annotations
 
+import math
 import re
 from pathlib import Path
 from typing import Any
 
 import click
 
-from microg.cli.params import Integer, Number, PathType
+from microg.cli._common import Option, num, written
+from microg.cli.params import Integer, Number, PathType, QuantityType
+from microg.environment.drag import AP_DEFAULT, CD_DEFAULT, DATE_DEFAULT, F107_DEFAULT
+from microg.environment.orbit import INCLINATION_DEG
 from microg.errors import InputError
 
 __all__ = ["quasi_steady", "FLAGS"]
@@ -35,7 +39,7 @@ FLAGS = {
     "f107": "--f107",
     "f107a": "--f107a",
     "ap": "--ap",
-    "points": "--point",
+    "points": "--observe",
     "lvlh_from_station": "--attitude",
 }
 
@@ -94,7 +98,7 @@ def _vector(text: str | None, where: str, *, accel: bool = False) -> list[float]
             if abs(q) > LIMITS["angular_frequency"]:  # a rate, however small, may be 0 or tiny
                 raise InputError(
                     f"{p} {unit or 'rad/s'} is beyond the physical limit of "
-                    f"{LIMITS['angular_frequency']:.6g} rad/s",
+                    f"{num(LIMITS['angular_frequency'])} rad/s",
                     where=where,
                     fix="check the value and its unit",
                 )
@@ -102,7 +106,7 @@ def _vector(text: str | None, where: str, *, accel: bool = False) -> list[float]
     return out
 
 
-@click.command(name="quasi-steady")
+@click.command(name="quasi-steady", short_help="Quasi-steady acceleration (below 0.01 Hz).")
 @click.argument("model")
 @click.option(
     "--attitude",
@@ -112,22 +116,38 @@ def _vector(text: str | None, where: str, *, accel: bool = False) -> list[float]
     help="LVLH hold, fixed in inertial space (aligned with LVLH at the first sample), or a "
     "constant body rate (--rate).",
 )
-@click.option("--rate", default=None, help="Body rate 'wx wy wz [unit]' (default rad/s).")
+@click.option("--rate", default=None, help="Body rate 'wx wy wz [unit]' (bare numbers: rad/s).")
 @click.option(
     "--angular-acceleration",
     "angular_acceleration",
     default=None,
-    help="Angular acceleration 'ax ay az [unit]' (default rad/s^2), with --attitude rate.",
+    help="Angular acceleration 'ax ay az [unit]' (bare numbers: rad/s^2), with --attitude rate.",
 )
 @click.option(
-    "--radius", default=None, help="Orbit radius (default: the model's orbit), e.g. '6778 km'."
+    "--radius",
+    default=None,
+    cls=Option,
+    show_default="the model's orbit",
+    help="Orbit radius, e.g. '6778 km' (bare number: m).",
 )
-@click.option("--altitude", default=None, help="Orbit altitude above the equatorial radius.")
-@click.option("--inclination", type=Number(), default=51.6, show_default=True, help="Degrees.")
-@click.option("--raan", type=Number(), default=0.0, show_default=True, help="Node, degrees.")
 @click.option(
-    "--samples", type=Integer(), default=180, show_default=True, help="Samples over one orbit."
+    "--altitude",
+    default=None,
+    help="Orbit altitude above the equatorial radius, e.g. '400 km' (bare number: m).",
 )
+@click.option(
+    "--inclination",
+    type=QuantityType("angle", "deg"),
+    default=f"{INCLINATION_DEG:g} deg",
+    help="Orbit inclination, e.g. '51.6 deg' (bare number: degrees).",
+)
+@click.option(
+    "--raan",
+    type=QuantityType("angle", "deg"),
+    default="0 deg",
+    help="Right ascension of the ascending node (bare number: degrees).",
+)
+@click.option("--samples", type=Integer(), default=180, help="Samples over one orbit.")
 @click.option(
     "--ballistic-coefficient",
     "ballistic_coefficient",
@@ -135,8 +155,21 @@ def _vector(text: str | None, where: str, *, accel: bool = False) -> list[float]
     help="m / (Cd A), e.g. '100 kg/m^2' (or give --area and --cd).",
 )
 @click.option("--area", default=None, help="Reference area for drag, e.g. '900 m^2'.")
-@click.option("--cd", type=Number(), default=None, help="Drag coefficient with --area [2.2].")
-@click.option("--mass", default=None, help="Mass for drag with --area (default: the model's).")
+@click.option(
+    "--cd",
+    type=Number(),
+    default=None,
+    cls=Option,
+    show_default=f"{CD_DEFAULT:g}",
+    help="Drag coefficient with --area.",
+)
+@click.option(
+    "--mass",
+    default=None,
+    cls=Option,
+    show_default="the model's",
+    help="Mass for drag with --area, e.g. '4.2e5 kg'.",
+)
 @click.option(
     "--atmosphere",
     type=click.Choice(["msis", "exponential"]),
@@ -144,16 +177,49 @@ def _vector(text: str | None, where: str, *, accel: bool = False) -> list[float]
     show_default=True,
     help="NRLMSIS 2.1 (pymsis) or the exponential atmosphere (Vallado 2013 Table 8-4).",
 )
-@click.option("--date", default=None, help="UTC date and time, e.g. 2024-03-20T12:00:00.")
-@click.option("--f107", type=Number(), default=None, help="Daily F10.7, sfu [150].")
-@click.option("--f107a", type=Number(), default=None, help="81-day mean F10.7, sfu [150].")
-@click.option("--ap", type=Number(), default=None, help="Daily Ap index [15].")
-@click.option("--point", "points", multiple=True, help="Named point to report (repeatable).")
+@click.option(
+    "--date",
+    default=None,
+    cls=Option,
+    show_default=DATE_DEFAULT,
+    help="UTC date and time of the atmosphere, e.g. 2024-03-20T12:00:00.",
+)
+@click.option(
+    "--f107",
+    type=Number(),
+    default=None,
+    cls=Option,
+    show_default=f"{F107_DEFAULT:g}",
+    help="Daily F10.7 solar flux, sfu.",
+)
+@click.option(
+    "--f107a",
+    type=Number(),
+    default=None,
+    cls=Option,
+    show_default="--f107",
+    help="81-day mean F10.7, sfu.",
+)
+@click.option(
+    "--ap",
+    type=Number(),
+    default=None,
+    cls=Option,
+    show_default=f"{AP_DEFAULT:g}",
+    help="Daily Ap index.",
+)
+@click.option(
+    "--observe",
+    "points",
+    multiple=True,
+    cls=Option,
+    show_default="every named point",
+    help="Named point to report (repeatable).",
+)
 @click.option(
     "--elements",
     type=Integer(1, 200),
     default=20,
-    show_default=True,
     help="Frame elements per beam of the map's sample points.",
 )
 @click.option(
@@ -224,8 +290,8 @@ def quasi_steady(
         orbit = qs.OrbitInputs(
             radius_m=r,
             mu_m3_per_s2=station.orbit.mu,
-            inclination_deg=inclination,
-            raan_deg=raan,
+            inclination_deg=math.degrees(inclination),
+            raan_deg=math.degrees(raan),
             n_samples=samples,
         )
         att = qs.Attitude(
@@ -294,13 +360,13 @@ def _summary(result: Any, out_dir: Path | None) -> None:
     ug = 1e6 / G0
     cm = result.center_of_mass_m
     click.echo(
-        f"{result.model}: centre of mass ({cm[0]:.4g}, {cm[1]:.4g}, {cm[2]:.4g}) m, "
-        f"mass {result.mass_kg:.6g} kg; orbit radius {result.orbit.radius_m / 1e3:.6g} km, "
-        f"n = {result.mean_motion_rad_s:.6g} rad/s; attitude {result.attitude.kind}"
+        f"{result.model}: centre of mass ({num(cm[0])}, {num(cm[1])}, {num(cm[2])}) m, "
+        f"mass {num(result.mass_kg)} kg; orbit radius {num(result.orbit.radius_m / 1e3)} km, "
+        f"n = {num(result.mean_motion_rad_s)} rad/s; attitude {result.attitude.kind}"
     )
     rho = result.density_kg_per_m3
     click.echo(
-        f"atmosphere: {result.atmosphere_model}, density {rho.min():.3g}-{rho.max():.3g} kg/m^3"
+        f"atmosphere: {result.atmosphere_model}, density {num(rho.min())}-{num(rho.max())} kg/m^3"
     )
     limit = result.requirement.limit_g * 1e6
     click.echo(
@@ -319,8 +385,8 @@ def _summary(result: Any, out_dir: Path | None) -> None:
         click.echo(
             f"map: {m['n_within_limit']} of {m['n_samples']} sample points within {limit:g} ug"
             + (
-                f"; ideal zone half-widths y {m['zone_half_width_m']['y']:.3g} m, "
-                f"z {m['zone_half_width_m']['z']:.3g} m about the CM"
+                f"; ideal zone half-widths y {num(m['zone_half_width_m']['y'])} m, "
+                f"z {num(m['zone_half_width_m']['z'])} m about the CM"
                 if m["zone_half_width_m"]
                 else ""
             )
@@ -330,4 +396,4 @@ def _summary(result: Any, out_dir: Path | None) -> None:
     for w in result.warnings:
         click.echo(f"warning: {w}")
     if out_dir is not None:
-        click.echo(f"wrote {out_dir}")
+        written(out_dir)

@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING
 
 import click
 
+from microg.cli._common import num, written
 from microg.cli.params import PathType, QuantityType
 from microg.seed.ioc import CASES
 
@@ -163,14 +164,15 @@ def _summary(rep: Reproduction, path: Path) -> None:
     for case, t4 in rep.table4.items():
         for j, b in enumerate(t4.bending, 1):
             click.echo(
-                f"  {case:14s} bending {j}: w {b.printed_omega:.4g} -> {b.omega:.4g} rad/s, "
-                f"a_e {b.printed_accel_g:.3g} -> {b.accel_g:.3g} g"
+                f"  {case:14s} bending {j}: w {num(b.printed_omega)} -> {num(b.omega)} rad/s, "
+                f"a_e {num(b.printed_accel_g)} -> {num(b.accel_g)} g"
             )
         lib = t4.libration
         click.echo(
-            f"  {case:14s} libration: w {lib.printed_omega:.4g} -> {lib.omega:.4g} rad/s, "
-            f"a_e {lib.printed_accel_g:.3g} -> {lib.accel_g:.3g} g"
+            f"  {case:14s} libration: w {num(lib.printed_omega)} -> {num(lib.omega)} rad/s, "
+            f"a_e {num(lib.printed_accel_g)} -> {num(lib.accel_g)} g"
         )
     if rep.agreement is not None:
         click.echo(rep.agreement.headline)
-    click.echo(f"{len(rep.errata)} errata entries; report written to {path / 'report.html'}")
+    click.echo(f"{len(rep.errata)} errata entries")
+    written(path)

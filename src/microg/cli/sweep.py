@@ -13,6 +13,7 @@ from pathlib import Path
 
 import click
 
+from microg.cli._common import num, written
 from microg.cli._errors import flag_errors
 from microg.cli.params import Integer, Number, PathType
 
@@ -162,8 +163,7 @@ def sweep(
     for row in summary.worst_list()[:10]:
         c = row["case"]
         label = ", ".join(f"{k}={c[k]}" for k in c if len(study.coords[k]) > 1) or "the case"
-        click.echo(f"  worst at {c['observe']}: margin {row['margin']} ({label})")
+        click.echo(f"  worst at {c['observe']}: margin {num(row['margin'])} ({label})")
     for w in summary.warnings:
         click.echo(f"  warning: {w}")
-    click.echo(f"results in {result.out / 'results.zarr'}; report written to "
-               f"{result.out / 'report.html'}")  # fmt: skip
+    written(result.out)

@@ -19,6 +19,7 @@ from microg.errors import InputError
 __all__ = [
     "EARTH_EQUATORIAL_RADIUS_M",
     "EARTH_ROTATION_RAD_S",
+    "INCLINATION_DEG",
     "MAX_SAMPLES",
     "OrbitInputs",
     "OrbitSamples",
@@ -68,6 +69,10 @@ def geodetic(r_ecef_m: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return np.degrees(lat), np.degrees(np.arctan2(y, x)), alt
 
 
+#: the ISS orbit's inclination, degrees
+INCLINATION_DEG = 51.6
+
+
 @dataclass(frozen=True)
 class OrbitInputs:
     """A circular orbit.
@@ -84,7 +89,7 @@ class OrbitInputs:
 
     radius_m: float
     mu_m3_per_s2: float = 3.986004418e14
-    inclination_deg: float = 51.6
+    inclination_deg: float = INCLINATION_DEG
     raan_deg: float = 0.0
     arg_latitude_deg: float = 0.0
     n_samples: int = 180
