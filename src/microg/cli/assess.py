@@ -10,7 +10,7 @@ from typing import Any
 
 import click
 
-from microg.cli._common import num, written
+from microg.cli._common import Option, num, written
 from microg.cli.params import PathType, QuantityType
 
 __all__ = ["assess", "merge_assessments", "run_assessment"]
@@ -26,7 +26,7 @@ FLAGS = {
 }
 
 
-@click.command()
+@click.command(short_help="Assess a measured acceleration record FILE.")
 @click.argument("file", type=PathType(path_type=Path))
 @click.option(
     "--interval",
@@ -55,7 +55,9 @@ FLAGS = {
     "--segment",
     type=QuantityType("time", "s", minimum=0.0, strict=True),
     default=None,
-    help="Welch segment length. [default: each interval, and the whole record for its PSD]",
+    cls=Option,
+    show_default="each interval, and the whole record for its PSD",
+    help="Welch segment length.",
 )
 @click.option(
     "--transient",
@@ -66,7 +68,9 @@ FLAGS = {
 @click.option(
     "--sensor",
     default=None,
-    help="Name of the record in the output (files of one record). [default: the file's]",
+    cls=Option,
+    show_default="the file's",
+    help="Name of the record in the output (files of one record).",
 )
 @click.option("--json", "as_json", is_flag=True, help="Print the results as JSON to stdout.")
 @click.option(

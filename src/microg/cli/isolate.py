@@ -15,7 +15,7 @@ import click
 import numpy as np
 
 from microg._io import dumps
-from microg.cli._common import num, written
+from microg.cli._common import Option, num, written
 from microg.cli.params import BandType, PathType, PositiveFloat, QuantityType, RangeType
 from microg.units import LBF
 
@@ -63,7 +63,7 @@ def _target(ctx: click.Context, param: click.Parameter, value: float) -> float:
     return value
 
 
-@click.group()
+@click.group(short_help="Suspension and vibration-absorber design.")
 def isolate() -> None:
     """Isolation of an experiment package: spring mount plus damped absorber (Section 4).
 
@@ -72,7 +72,7 @@ def isolate() -> None:
     """
 
 
-@isolate.command()
+@isolate.command(short_help="M_a against r^2 of a mount and absorber.")
 @click.option("--k", "k", type=PositiveFloat(), required=True, help="spring ratio k1/k2 (> 0)")
 @click.option("--mu", type=PositiveFloat(), required=True, help="mass ratio m2/m1 (> 0)")
 @click.option(
@@ -111,13 +111,15 @@ def curve(k: float, mu: float, zeta: float, r2: tuple[float, float, int], as_jso
         click.echo(f"{x:10.4f} {m:12.5g} {b:12.5g}")
 
 
-@isolate.command()
+@isolate.command(short_help="The optimal absorber for mass ratio MU.")
 @click.option("--mu", type=PositiveFloat(), required=True, help="mass ratio m2/m1 (> 0)")
 @click.option(
     "--band",
     type=BandType(),
     default=None,
-    help="band of the frequency ratio r = omega/omega_n (not r^2), LO:HI; default all r",
+    cls=Option,
+    show_default="all r",
+    help="band of the frequency ratio r = omega/omega_n (not r^2), LO:HI",
 )
 @click.option(
     "--criterion",
@@ -130,7 +132,9 @@ def curve(k: float, mu: float, zeta: float, r2: tuple[float, float, int], as_jso
     "--zeta",
     type=PositiveFloat(0.0, strict=False),
     default=None,
-    help="hold the absorber damping ratio fixed (default: optimised)",
+    cls=Option,
+    show_default="optimised",
+    help="hold the absorber damping ratio fixed",
 )
 @click.option("--json", "as_json", is_flag=True, help="print {k, zeta, f, peak_Ma, criterion}")
 @_flagged
@@ -158,7 +162,7 @@ def tune(
         click.echo("(the closed form is for all r; its figures are over all r)")
 
 
-@isolate.command()
+@isolate.command(short_help="The stiffest mount spring meeting TARGET.")
 @click.option(
     "--weight",
     type=QuantityType("force", "lbf", minimum=0, strict=True),
@@ -274,7 +278,7 @@ def design(
         )
 
 
-@isolate.command()
+@isolate.command(short_help="The numbers of Section 4.2, recomputed.")
 @click.option(
     "--mu-max",
     type=PositiveFloat(),
@@ -300,7 +304,7 @@ def claims(mu_max: float, as_json: bool) -> None:
         click.echo(f"    note:       {c.note}")
 
 
-@isolate.command()
+@isolate.command(short_help="Figure 8 of the report.")
 @click.option(
     "--out",
     type=PathType(dir_okay=False),

@@ -19,7 +19,7 @@ from microg.errors import InputError
 __all__ = ["active"]
 
 
-@click.command("active")
+@click.command("active", short_help="Design and verify an active isolator.")
 @click.option(
     "--preset",
     type=click.Choice(["aris", "g-limit"]),

@@ -8,9 +8,11 @@ from typing import TYPE_CHECKING
 
 import click
 
-from microg.cli._common import num, written
+from microg import defaults
+from microg.cli._common import Option, num, written
 from microg.cli.params import PathType, QuantityType
 from microg.seed.ioc import CASES
+from microg.units import LBF
 
 if TYPE_CHECKING:
     from microg.seed.reproduce import Reproduction
@@ -31,7 +33,7 @@ class _RecordedCommand(click.Command):
         return super().parse_args(ctx, args)
 
 
-@click.command(cls=_RecordedCommand)
+@click.command(cls=_RecordedCommand, short_help="The seed report recomputed, with errata.")
 @click.option(
     "--out",
     "out_dir",
@@ -50,29 +52,25 @@ class _RecordedCommand(click.Command):
 @click.option(
     "--f0",
     type=QuantityType("force", "lbf"),
-    default="25 lbf",
-    show_default=True,
+    default=f"{defaults.CREW_F0_N / LBF:g} lbf",
     help="Crew force peak f0 (Eq. 2.16), > 0, e.g. '111 N' (bare number: lbf).",
 )
 @click.option(
     "--t1",
     type=QuantityType("time", "s", minimum=0.0, strict=True),
-    default="1 s",
-    show_default=True,
+    default=f"{defaults.CREW_T1_S:g} s",
     help="End of the push-off ramp t1 (Eq. 2.16), > 0 (bare number: s).",
 )
 @click.option(
     "--t13",
     type=QuantityType("time", "s"),
-    default="13 s",
-    show_default=True,
+    default=f"{defaults.CREW_T13_S:g} s",
     help="Start of the landing t13, >= t1 (bare number: s).",
 )
 @click.option(
     "--t14",
     type=QuantityType("time", "s"),
-    default="14 s",
-    show_default=True,
+    default=f"{defaults.CREW_T14_S:g} s",
     help="End of the landing t14, > t13 (bare number: s).",
 )
 @click.option(
@@ -98,8 +96,10 @@ class _RecordedCommand(click.Command):
     "cases",
     type=click.Choice(list(CASES)),
     multiple=True,
+    cls=Option,
+    show_default="all four",
     help="Restrict to a case of Appendix C (repeatable): X-Z or Y-Z plane, with or without "
-    "the orbiter (C-1..C-4). Default: all four.",
+    "the orbiter (C-1..C-4).",
 )
 def reproduce(
     out_dir: Path,

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import click
 
-from microg.cli._common import num, written
+from microg.cli._common import Option, num, written
 from microg.cli._errors import flag_errors
 from microg.cli.params import Integer, Number, PathType
 
@@ -30,7 +30,7 @@ FLAGS = {
 }
 
 
-@click.command()
+@click.command(short_help="Every case of a study by superposition.")
 @click.argument("study_file", metavar="STUDY.toml", type=PathType(path_type=Path))
 @click.option(
     "--out",
@@ -64,7 +64,9 @@ FLAGS = {
     "--heatmap",
     default=None,
     metavar="AXIS1,AXIS2",
-    help="The two axes of the margin heat map. [default: at,observe when both vary]",
+    cls=Option,
+    show_default="at,observe when both vary",
+    help="The two axes of the margin heat map.",
 )
 @click.option(
     "--restart",

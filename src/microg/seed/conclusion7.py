@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from microg.defaults import PRESETS
 from microg.dynamics.crew import CrewPushoff
 from microg.location.mapping import AccelerationMap, acceleration_map, best_location
 from microg.location.peaks import elastic_modes
@@ -172,10 +173,13 @@ def conclusion7_case(
     """
     from microg.dynamics.modes import solve_modes
 
-    structure, d = location_structure(station, "ritz", "xz", 1, "x")
+    report = PRESETS["report"]
+    structure, d = location_structure(
+        station, report["method"], report["plane"], report["functions"], "x"
+    )
     modes = solve_modes(structure)
-    amap = acceleration_map(structure, modes, point, d, crew)
-    site = point_peak(structure, modes, point, point, d, crew)
+    amap = acceleration_map(structure, modes, point, d, crew, zeta=report["damping"])
+    site = point_peak(structure, modes, point, point, d, crew, zeta=report["damping"])
     el = elastic_modes(modes)
     total, cm, _ = station.mass_properties()
     lab_z = float(structure.point(point).position[2])

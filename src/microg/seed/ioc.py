@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+from microg.defaults import PRESETS
 from microg.errors import InputError
 from microg.models.station import Station
 from microg.structure.ritz import build_ritz
@@ -174,7 +175,9 @@ def report_matrices(
     gravity_gradient : bool
         Include the gravity-gradient k22 (Appendix B-2 with the 1/l_k^2 factor).
     """
-    s = build_ritz(station, plane, 1, gravity_gradient=gravity_gradient)
+    s = build_ritz(
+        station, plane, PRESETS["report"]["functions"], gravity_gradient=gravity_gradient
+    )
     t = report_reduction(s)
     m = t.T @ s.mass @ t
     k = t.T @ s.stiffness @ t

@@ -247,7 +247,21 @@ class _Builder:
             raise self.err("study.plane", f"unknown plane {s.plane!r}", "use 3d, xz or yz")
         if s.units is not None and s.units not in ("SI", "US"):
             raise self.err("study.units", f"unknown unit system {s.units!r}", "use SI or US")
-        return Discretisation(s.method, s.plane, s.n, s.n_modes, s.gravity_gradient)
+        wrong, right = (
+            ("elements", "functions") if s.method == "ritz" else ("functions", "elements")
+        )
+        if getattr(s, wrong) is not None:
+            raise self.err(
+                f"study.{wrong}",
+                f"applies to method {'fem' if s.method == 'ritz' else 'ritz'}",
+                f"use study.{right} with method {s.method}",
+            )
+        n = getattr(s, right)
+        if s.n is not None:
+            if n is not None:
+                raise self.err("study.n", f"give study.{right} only", "n is its old name")
+            n = s.n
+        return Discretisation(s.method, s.plane, n, s.n_modes, s.gravity_gradient)
 
     def record(self) -> Record:
         from microg.environment.requirements import requirement

@@ -89,7 +89,9 @@ class StudyIn(_In):
     model: _ModelRef | Annotated[list[_ModelRef], Field(min_length=1, max_length=1000)]
     method: StrictStr = DEFAULTS["method"]
     plane: StrictStr = DEFAULTS["plane"]
-    n: Annotated[int, Field(ge=1, le=10_000)] | None = None
+    functions: Annotated[int, Field(ge=1, le=10_000)] | None = None
+    elements: Annotated[int, Field(ge=1, le=10_000)] | None = None
+    n: Annotated[int, Field(ge=1, le=10_000)] | None = None  # deprecated: functions/elements
     n_modes: Annotated[int, Field(ge=1, le=2000)] | None = None
     gravity_gradient: StrictBool = DEFAULTS["gravity_gradient"]
     units: StrictStr | None = None
