@@ -233,7 +233,9 @@ def test_static_report_has_no_interactive_view(tmp_path: Path) -> None:
     [
         (["--duration", "1e9 s"], "--duration"),
         (["--duration", "inf s"], "--duration"),
-        (["--method", "ritz", "--elements", "40"], "functions"),
+        (["--method", "ritz", "--functions", "40"], "--functions"),
+        (["--method", "ritz", "--elements", "4"], "--elements: applies to --method fem only"),
+        (["--functions", "4"], "--functions: applies to --method ritz only"),
         (["--out", "/proc/microg-no-such-dir/x"], "--out"),
     ],
 )

@@ -56,7 +56,7 @@ def test_wtmass_must_be_a_positive_finite_number(value, capsys) -> None:
     [
         ["modes", "ioc", "--elements", "\u0661\u0660"],  # Arabic-Indic 10: int() reads it
         ["modes", "ioc", "--elements", "1_0"],  # int() reads 10
-        ["quasi-steady", "ioc", "--inclination", "5_1.6"],
+        ["quasi-steady", "ioc", "--samples", "1_80"],
         ["isolate", "curve", "--k", "1_0", "--mu", "0.05", "--zeta", "0.1"],
         ["isolate", "curve", "--k", "1", "--mu", "0.05", "--zeta", "0.1", "--r2", "0:\u0662:10"],
         ["isolate", "tune", "--mu", "0.05", "--band", "0:1_0"],

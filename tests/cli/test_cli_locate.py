@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from microg import defaults
 from microg.cli import main
 from microg.dynamics.crew import CrewPushoff
 from microg.dynamics.forces import REPORT_F0_N
@@ -86,7 +87,9 @@ def crewless_model(tmp_path):
 
 
 def test_locate_json_matches_library(capsys):
-    rc, out, err = _run(capsys, "locate", "ioc", "--crew", "crew", "--json", "--on", "main")
+    # the report preset: the planar assumed-modes model, one function per beam, no damping
+    args = ["locate", "ioc", "--preset", "report", "--at", "crew", "--json", "--on", "main"]
+    rc, out, err = _run(capsys, *args)
     assert rc == 0 and err == ""
     data = json.loads(out)
     for key in ("samples", "nodes", "best_location", "modes", "fundamental", "window_s"):
@@ -103,12 +106,22 @@ def test_locate_json_matches_library(capsys):
     # the JSON is the library result's to_dict()
     same_force = CrewPushoff(data["force"]["f0_N"])
     assert data == json.loads(
-        json.dumps(locate("ioc", "crew", force=same_force, on="main").to_dict())
+        json.dumps(
+            locate(
+                "ioc",
+                "crew",
+                force=same_force,
+                on="main",
+                **{"method": "ritz", "plane": "xz"},
+                n=1,
+                zeta=0.0,
+            ).to_dict()
+        )
     )
 
 
 def test_locate_defaults_to_the_models_crew_point(capsys):
-    # `microg locate ioc` printed "microg: error: --crew: " (no message)
+    # `microg locate ioc` printed "microg: error: --at: " (no message)
     rc, out, err = _run(capsys, "locate", "ioc", "--json")
     assert rc == 0 and err == ""
     data = json.loads(out)
@@ -118,7 +131,7 @@ def test_locate_defaults_to_the_models_crew_point(capsys):
 
 def test_locate_writes_png_and_json(capsys, tmp_path):
     out_dir = tmp_path / "map"
-    rc, out, _ = _run(capsys, "locate", "ioc-no-orbiter", "--crew", "lab", "--out", str(out_dir))
+    rc, out, _ = _run(capsys, "locate", "ioc-no-orbiter", "--at", "lab", "--out", str(out_dir))
     assert rc == 0 and "best location" in out and "node on main" in out
     assert (out_dir / "map.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert json.loads((out_dir / "map.json").read_text())["crew_point"] == "lab"
@@ -129,7 +142,7 @@ def test_locate_fem_and_damping(capsys):
         capsys,
         "locate",
         "ioc",
-        "--crew",
+        "--at",
         "crew",
         "--method",
         "fem",
@@ -165,39 +178,44 @@ def test_out_is_checked_before_computing(capsys, tmp_path, monkeypatch):
 
 
 BAD = [
-    (["locate", "ioc", "--crew", "nowhere"], "--crew: unknown point 'nowhere'"),
-    (["locate", "ioc", "--crew", "nowhere"], "known points: boom-tip, crew"),
-    (["locate", "ioc", "--crew", "crew", "--direction", "z"], "--direction"),
-    (["locate", "ioc", "--crew", "crew", "--direction", "w"], "--direction"),
-    (["locate", "ioc", "--crew", "crew", "--damping", "1.5"], "--damping"),
-    (["locate", "ioc", "--crew", "crew", "--f0", "3 m"], "--f0"),
-    (["locate", "ioc", "--f0", "0 lbf"], "--f0"),
-    (["optimize", "ioc", "--t14", "12 s", "--movable", "Horizontal lab=-91ft:-5ft"], "--t14"),
-    (["locate", "ioc", "--crew", "crew", "--on", "hull"], "--on: no samples on 'hull'"),
-    (["locate", "ioc", "--crew", "crew", "--on", "hull"], "known components"),
-    (["locate", "ioc", "--elements", "3"], "--elements"),
-    (["locate", "ioc", "--method", "fem", "--functions", "3"], "--functions"),
-    (["locate", "nope", "--crew", "crew"], "no such file"),
-    (["optimize", "ioc", "--experiment", "lab", "--crew", "crew"], "--movable: no movable"),
+    (["locate", "ioc", "--at", "nowhere"], "--at: unknown point 'nowhere'"),
+    (["locate", "ioc", "--at", "nowhere"], "known points: boom-tip, crew"),
+    (["locate", "ioc", "--preset", "report", "--direction", "z"], "--direction"),
+    (["locate", "ioc", "--at", "crew", "--direction", "w"], "--direction"),
+    (["locate", "ioc", "--at", "crew", "--damping", "1.5"], "--damping"),
+    (["locate", "ioc", "--at", "crew", "--force", "crew-pushoff:f0=3m"], "--force"),
+    (["locate", "ioc", "--force", "crew-pushoff:f0=0lbf"], "--force crew-pushoff:f0=0lbf: f0"),
+    (["locate", "ioc", "--force", "stomp"], "--force: unknown force 'stomp'"),
     (
-        ["optimize", "ioc", "--experiment", "lab", "--crew", "crew", "--movable", "Piano=0:1"],
+        ["optimize", "ioc", "--force", "crew-pushoff:t14=12s", "--movable", "Horizontal lab=0:1"],
+        "--force crew-pushoff:t14=12s: t14",
+    ),
+    (["locate", "ioc", "--at", "crew", "--on", "hull"], "--on: no samples on 'hull'"),
+    (["locate", "ioc", "--at", "crew", "--on", "hull"], "known components"),
+    (["locate", "ioc", "--method", "ritz", "--elements", "3"], "--elements"),
+    (["locate", "ioc", "--crew", "crew"], "no such option --crew"),
+    (["locate", "ioc", "--method", "fem", "--functions", "3"], "--functions"),
+    (["locate", "nope", "--at", "crew"], "no such file"),
+    (["optimize", "ioc", "--observe", "lab", "--at", "crew"], "--movable: no movable"),
+    (
+        ["optimize", "ioc", "--observe", "lab", "--at", "crew", "--movable", "Piano=0:1"],
         "known masses",
     ),
     (
-        ["optimize", "ioc", "--experiment", "lab", "--crew", "crew", "--movable", "x"],
+        ["optimize", "ioc", "--observe", "lab", "--at", "crew", "--movable", "x"],
         "NAME=LO:HI",
     ),
     (
-        ["optimize", "ioc", "--experiment", "lab", "--crew", "crew", "--movable", "TDM 2010=0:10"],
+        ["optimize", "ioc", "--observe", "lab", "--at", "crew", "--movable", "TDM 2010=0:10"],
         "ambiguous",
     ),
     (
         [
             "optimize",
             "ioc",
-            "--experiment",
+            "--observe",
             "lab",
-            "--crew",
+            "--at",
             "crew",
             "--movable",
             "Horizontal lab=-200ft:0ft",
@@ -208,14 +226,14 @@ BAD = [
         [
             "optimize",
             "ioc",
-            "--experiment",
+            "--observe",
             "nowhere",
-            "--crew",
+            "--at",
             "crew",
             "--movable",
             "Horizontal lab=-91ft:-5ft",
         ],
-        "--experiment: unknown point",
+        "--observe: unknown point",
     ),
     (
         ["optimize", "ioc", "--movable", "Horizontal lab=-91ft:-5ft", "--carry", "lab=Piano"],
@@ -234,20 +252,20 @@ def test_bad_input_is_one_line_exit_2(capsys, tmp_path, args, needle):
     rc, out, err = _run(capsys, *args)
     assert rc == 2 and out == ""
     assert len(err.strip().splitlines()) == 1 and needle in err
-    # never a blank message ("microg: error: --crew: " and nothing after it)
+    # never a blank message ("microg: error: --at: " and nothing after it)
     assert re.match(r"^microg: error: (--[\w-]+( [^:]+)?: )?\S", err), err
 
 
 def test_model_without_crew_point_is_a_message(capsys, crewless_model):
     rc, out, err = _run(capsys, "locate", str(crewless_model))
     assert rc == 2 and out == ""
-    assert err.startswith("microg: error: --crew: the model has no crew point")
+    assert err.startswith("microg: error: --at: the model has no crew point")
     assert "name one of: lab, crew" in err
 
 
 def test_bad_input_writes_nothing(capsys, tmp_path):
     out_dir = tmp_path / "never"
-    rc, _, _ = _run(capsys, "locate", "ioc", "--crew", "nowhere", "--out", str(out_dir))
+    rc, _, _ = _run(capsys, "locate", "ioc", "--at", "nowhere", "--out", str(out_dir))
     assert rc == 2 and not out_dir.exists()
 
 
@@ -256,9 +274,9 @@ def test_optimize_json(capsys):
         capsys,
         "optimize",
         "ioc",
-        "--experiment",
+        "--observe",
         "lab",
-        "--crew",
+        "--at",
         "crew",
         "--movable",
         "boom+y/TDM 2010=10ft:120ft",
@@ -282,8 +300,8 @@ def test_optimize_json(capsys):
 
 
 def test_optimize_readme_example_reports_total_and_parts(capsys):
-    # README: microg optimize ioc --experiment lab --crew crew --movable "Horizontal lab=..."
-    args = ["optimize", "ioc", "--experiment", "lab", "--crew", "crew"]
+    # README: microg optimize ioc --preset report --observe lab --movable "Horizontal lab=..."
+    args = ["optimize", "ioc", "--preset", "report", "--observe", "lab", "--at", "crew"]
     rc, out, err = _run(capsys, *args, "--movable", "Horizontal lab=-91ft:-5ft")
     assert rc == 0 and err == ""  # not a TTY: no progress bar
     m = re.search(r"total peak \(objective\): (\S+) g -> (\S+) g \(x(\S+) lower\)", out)
@@ -338,7 +356,8 @@ def ioc_uff(tmp_path_factory):
     md = solve_modes(s, 30)
     d = tmp_path_factory.mktemp("uff")
     uff = write_uff_modes(md, d / "ioc.unv", precision="double", points_path=d / "ioc.toml")
-    ref = acceleration_map(s, md, "crew", "x", CrewPushoff(REPORT_F0_N))  # the CLI default
+    # the CLI default: the report's push-off, the default damping
+    ref = acceleration_map(s, md, "crew", "x", CrewPushoff(REPORT_F0_N), zeta=defaults.DAMPING)
     return uff, d / "ioc.toml", ref, len(s.samples.labels)
 
 
@@ -350,7 +369,7 @@ def test_locate_cli_on_a_uff_modal_model(capsys, ioc_uff):
         str(uff),
         "--points",
         str(pts),
-        "--crew",
+        "--at",
         "crew",
         "--direction",
         "x",
@@ -366,7 +385,7 @@ def test_locate_cli_on_a_uff_modal_model(capsys, ioc_uff):
     assert labels[:2] == ["grid:1", "grid:2"] and labels[-5:][1] == "crew"
     assert any("no beam line" in w for w in data["warnings"])
     rc, out, err = _run(
-        capsys, "locate", str(uff), "--points", str(pts), "--crew", "crew", "--on", "points"
+        capsys, "locate", str(uff), "--points", str(pts), "--at", "crew", "--on", "points"
     )
     assert rc == 0, err
     assert "best location (total) on points" in out and "grids: total peak" in out
@@ -378,7 +397,7 @@ def test_locate_cli_on_a_deck(capsys, tmp_path):
 
     deck = write_deck(tmp_path / "truss.bdf")
     rc, out, err = _run(
-        capsys, "locate", str(deck), "--units", "mm, N, s", "--crew", "grid:1", "--json"
+        capsys, "locate", str(deck), "--units", "mm, N, s", "--at", "grid:1", "--json"
     )
     assert rc == 0, err
     data = json.loads(out)
@@ -388,9 +407,9 @@ def test_locate_cli_on_a_deck(capsys, tmp_path):
     }
     # bad input: one line naming the option, exit 2, nothing on stdout
     for args, where in (
-        (["--crew", "grid:1"], "truss.bdf"),  # NASTRAN deck without units
-        (["--units", "mm, N, s", "--crew", "grid:77"], "--crew"),
-        (["--units", "N, N, s", "--crew", "grid:1"], "--units"),
+        (["--at", "grid:1"], "truss.bdf"),  # NASTRAN deck without units
+        (["--units", "mm, N, s", "--at", "grid:77"], "--at"),
+        (["--units", "N, N, s", "--at", "grid:1"], "--units"),
     ):
         rc, out, err = _run(capsys, "locate", str(deck), *args)
         assert rc == 2 and out == "" and len(err.strip().splitlines()) == 1, (args, err)

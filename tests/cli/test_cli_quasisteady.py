@@ -116,7 +116,9 @@ def test_rate_attitude_with_units(capsys):
         (["--attitude", "rate", "--rate", "1 2"], "--rate"),
         (["--date", "yesterday"], "--date"),
         (["--f107", "-3"], "--f107"),
-        (["--point", "galley"], "--point"),
+        (["--observe", "galley"], "--observe: unknown point 'galley'"),
+        (["--inclination", "51.6 m"], "--inclination: '51.6 m' is not an angle"),
+        (["--raan", "1 rad/s"], "--raan"),
         (["--radius", "7000 km", "--altitude", "400 km"], "--radius"),
     ],
 )
@@ -127,3 +129,15 @@ def test_bad_input_is_one_line_exit_2(capsys, tmp_path, args, flag):
     lines = err.strip().splitlines()
     assert len(lines) == 1 and flag in lines[0], err
     assert "Traceback" not in err and not out_dir.exists()
+
+
+def test_angles_take_units_and_bare_degrees(capsys) -> None:
+    # --inclination took a bare number of degrees only; now a quantity, bare = degrees
+    docs = []
+    for value in ("28.5", "28.5 deg", "0.4974188368 rad"):
+        rc, out, err = _run(capsys, "ioc", "--inclination", value, "--samples", "12", "--json")
+        assert rc == 0, err
+        docs.append(json.loads(out)["orbit"]["inclination_deg"])
+    # 0.4974188368 rad = 28.5 deg to the 10 digits written (28.5 pi / 180 = 0.49741883681838...)
+    assert docs[0] == docs[1] == pytest.approx(28.5, rel=1e-15)
+    assert docs[2] == pytest.approx(28.5, rel=1e-9)

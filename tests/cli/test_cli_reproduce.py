@@ -63,7 +63,7 @@ def test_files_written(tmp_path: Path, capsys) -> None:
     assert html.count("data:image/png;base64,") == 3  # figures embedded: self-contained
     assert "Errata" in html
     assert (out / "figure3.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    assert "report written" in stdout
+    assert "written to" in stdout
 
 
 def test_stdout_json_equals_file(tmp_path: Path, capsys) -> None:
@@ -307,7 +307,7 @@ def test_help_names_units_and_defaults(capsys) -> None:
         block = block[: block.index("[default:") + 60]
         assert unit in block and f"[default: {default}]" in block, option
     assert "-126.66 ft <= z <= 0" in text  # the range of --z-e and --z-a
-    assert "Default: all four" in text
+    assert "[default: all four]" in text
     assert TITLE.split(" and ")[0] in text  # the seed report, by its title
 
 

@@ -109,7 +109,7 @@ def test_resume_prints_what_was_resumed(run, study_file, capsys) -> None:
     out, _ = run
     rc, text, err = _run(capsys, ["sweep", str(study_file), "--out", str(out), "--no-progress"])
     assert rc == 0, err
-    assert "blocks resumed" in text and "report written" in text
+    assert "blocks resumed" in text and f"written to {out}" in text
 
 
 def test_heatmap_axes(run, study_file, capsys, tmp_path: Path) -> None:

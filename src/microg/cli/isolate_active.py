@@ -121,7 +121,7 @@ __all__ = ["active"]
 @click.option(
     "--allow-miss",
     is_flag=True,
-    help="print the result even when the target is out of reach (default: exit 2)",
+    help="print the result even when the target is out of reach, instead of exit status 2",
 )
 @click.option("--json", "as_json", is_flag=True, help="print the result as JSON")
 @click.option(
