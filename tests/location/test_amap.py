@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
+from microg import defaults
 from microg.dynamics.crew import CrewPushoff, acceleration_a
 from microg.dynamics.forces import REPORT_F0_N
 from microg.dynamics.modes import solve_modes
@@ -204,13 +205,19 @@ def test_point_peak_is_the_map_at_the_point(ioc, ioc_map):
 
 def test_locate_is_the_one_pipeline(ioc, ioc_map):
     # locate() = discretize (free-free) -> solve_modes -> acceleration_map -> best_location,
-    # with the model's first crew point by default
-    res = locate("ioc", on="main")
+    # with the model's first crew point by default; the report's settings as ioc_map's
+    res = locate("ioc", on="main", method="ritz", plane="xz", zeta=0.0)
     assert res.amap.crew_point == "crew"
     np.testing.assert_array_equal(res.amap.total_peak, ioc_map.total_peak)
     ref = best_location(ioc_map, component="main")
     assert (res.best.index, res.best.peak, res.best.measure) == (ref.index, ref.peak, ref.measure)
-    assert DEFAULTS["method"] == res.amap.method == "ritz" and res.amap.plane == "xz"
+    assert res.amap.method == "ritz" and res.amap.plane == "xz"
+    # the defaults are microg.defaults' (those of microg analyze)
+    assert (DEFAULTS["method"], DEFAULTS["plane"], DEFAULTS["zeta"]) == (
+        defaults.METHOD,
+        defaults.PLANE,
+        defaults.DAMPING,
+    )
     assert res.warnings == ()
 
 
@@ -219,7 +226,7 @@ def test_locate_validation():
         locate("ioc", "nowhere")
     assert exc.value.where == "crew" and "known points" in str(exc.value)
     with pytest.raises(InputError) as exc:
-        locate("ioc", direction="z")
+        locate("ioc", direction="z", method="ritz", plane="xz")
     assert exc.value.where == "direction"
     with pytest.raises(InputError) as exc:
         locate("ioc", measure="loudest")

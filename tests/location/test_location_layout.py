@@ -163,7 +163,8 @@ def test_fast_path_equals_the_one_entry():
         ]:
             s = fast.structure(x)
             got = point_peak(s, solve_modes(s), "lab", "crew", X, CREW)
-            ref = layout_objective(move_masses(station, masses, x, carry=carry_full), "lab", "crew")
+            moved = move_masses(station, masses, x, carry=carry_full)
+            ref = layout_objective(moved, "lab", "crew", plane="xz", zeta=0.0)
             for name in ("total", "elastic", "rigid", "bound"):
                 assert got.measure(name) == pytest.approx(ref.measure(name), rel=1e-9)
             big = ref.per_mode_mps2 > 1e-12 * ref.per_mode_mps2.max()
@@ -217,7 +218,7 @@ def test_optimizer_improves_and_respects_bounds_in_2d(small):
     ids=["readme", "docs-carry"],
 )
 def test_readme_example_gain_is_physical(carry):
-    # README: microg optimize ioc --experiment lab --crew crew
+    # README: microg optimize ioc --preset report --observe lab
     #         --movable "Horizontal lab=-91ft:-5ft"   (docs/locate.md adds both --carry)
     # An earlier version reported "1.162e-05 g -> 2.295e-37 g (x5.06e+31 lower)": the
     # objective left out the rigid-body acceleration.  The total now includes it, and is
