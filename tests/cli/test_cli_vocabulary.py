@@ -204,3 +204,16 @@ def test_modes_uff_says_what_it_wrote(capsys, tmp_path) -> None:
     rc, out, err = _run(capsys, "modes", "ioc", "--n-modes", "8", "--uff", str(path))
     assert rc == 0, err
     assert path.is_file() and out.rstrip().endswith(f"written to {path}")
+
+
+def test_locate_force_follows_analyzes_grammar(capsys) -> None:
+    # --f0 40 became --force crew-pushoff:f0=40lbf: the response is linear in f0, so every
+    # peak of the map scales by 40/25 exactly (to rounding, 1e-12)
+    peaks = []
+    for spec in ("crew-pushoff", "crew-pushoff:f0=40lbf"):
+        rc, out, err = _run(
+            capsys, "locate", "ioc", "--preset", "report", "--force", spec, "--json"
+        )
+        assert rc == 0, err
+        peaks.append([s["total_peak_g"] for s in json.loads(out)["samples"]])
+    assert peaks[1] == pytest.approx([40 / 25 * p for p in peaks[0]], rel=1e-12)

@@ -414,3 +414,20 @@ def test_breakpoints_of_a_vector_history_need_every_component_equal():
     # x is constant over t = 1..3 but y changes at 2..3: every row stays
     np.testing.assert_array_equal(tb, t)
     np.testing.assert_array_equal(vb, v)
+
+
+def test_crew_force_keeps_the_pushoff_closed_form():
+    # locate and optimize read analyze's force grammar; the push-off stays a CrewPushoff
+    # (its exact [A]max), parameters from the spec, the rest the report's (25 lbf, 1, 13, 14 s)
+    from microg.dynamics.crew import CrewPushoff
+    from microg.dynamics.forces import ForceHistory, crew_force
+
+    f = crew_force("crew-pushoff:f0=40lbf,t1=0.5s")
+    # 1 lbf = 4.4482216152605 N exactly (NIST SP 811)
+    assert f == CrewPushoff(40 * 4.4482216152605, 0.5, 13.0, 14.0)
+    assert crew_force(None) == crew_force("crew-pushoff") == CrewPushoff(25 * 4.4482216152605)
+    assert crew_force("crew-pushoff:f0=100", bare_units={"force": "N"}).f0 == 100.0
+    assert isinstance(crew_force("foot-pushoff-max"), ForceHistory)
+    with pytest.raises(InputError) as exc:
+        crew_force("crew-pushoff:t14=12s", where="force")
+    assert exc.value.where.startswith("force crew-pushoff:t14=12s: t14")
