@@ -24,6 +24,7 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING, Any
 
+from microg import defaults
 from microg.errors import InputError, MicrogError, ModelError, SolverError
 
 if TYPE_CHECKING:
@@ -116,9 +117,9 @@ def load_model(path: Any, **options: Any) -> Any:
 
 def solve_modes(
     model: Any,
-    method: str = "fem",
+    method: str = defaults.METHOD,
     *,
-    plane: str = "3d",
+    plane: str = defaults.PLANE,
     n: int | None = None,
     n_modes: int | None = None,
     gravity_gradient: bool = False,

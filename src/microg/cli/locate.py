@@ -2,9 +2,10 @@
 
 Both commands parse options (units at the boundary), call :func:`microg.location.amap.locate`
 or :func:`microg.location.layout.optimize_layout`, and print or write their results
-(``--json`` is the result's ``to_dict()``).  Defaults live in the library.  Library errors
-name parameters (``crew``, ``experiment``, ``movable``...); :func:`_as_flags` maps them to
-this command's options.
+(``--json`` is the result's ``to_dict()``).  Defaults are :mod:`microg.defaults`' (those of
+``microg analyze``); ``--at``, ``--observe`` and ``--force`` are ``analyze``'s words and force
+grammar.  Library errors name parameters (``crew``, ``experiment``, ``movable``...);
+:func:`_as_flags` maps them to this command's options.
 """
 
 from __future__ import annotations

@@ -231,24 +231,3 @@ def modes(
 def _pct(v: float) -> str:
     """A percentage; below 1e-9 % it is the rounding of M-orthogonality, shown as 0."""
     return "0" if abs(v) < 1e-9 else f"{num(v)}"
-
-
-# ---- transitional: cli/locate.py still imports these two; removed when it moves to the API
-def build_structure(
-    model: str, method: str, plane: str | None, functions: int | None, elements: int | None
-) -> tuple[Any, Any]:
-    """Load and discretise ``model`` (transitional helper for ``microg locate``)."""
-    import microg
-    from microg.errors import InputError
-    from microg.structure.discretize import discretize
-
-    if method == "ritz" and elements is not None:
-        raise InputError("applies to --method fem only", where="--elements")
-    if method == "fem" and functions is not None:
-        raise InputError("applies to --method ritz only", where="--functions")
-    station = microg.load_station(model)
-    if method == "ritz":
-        return station, discretize(
-            station, "ritz", plane=plane or "xz", n=functions, gravity_gradient=True
-        )
-    return station, discretize(station, "fem", n=elements)

@@ -498,8 +498,9 @@ def layout_objective(
     station : Station
     experiment, crew : str
         Named points (experiment site, crew force).
-    force : CrewPushoff or ForceHistory, optional
-        N (default: the report's push-off).
+    force : str, CrewPushoff or ForceHistory, optional
+        N, or a spec of :func:`~microg.dynamics.forces.crew_force` (default: the report's
+        push-off).
     method : {"ritz", "fem"}
     plane : {"xz", "yz", "3d"}
     n : int, optional
@@ -689,16 +690,20 @@ def optimize_layout(
         Named experiment site (default: the model's first point of kind experiment).
     crew : str, optional
         Named point of the crew force (default: the model's first point of kind crew).
-    force : CrewPushoff or ForceHistory, optional
-        N (default: the report's push-off, 25 lbf).
+    force : str, CrewPushoff or ForceHistory, optional
+        N, or a spec of :func:`~microg.dynamics.forces.crew_force` (``microg analyze
+        --force``'s grammar; bare values take the station's unit system); default: the
+        report's push-off, 25 lbf.
     movable : mapping of mass key to (lo, hi), optional
         Ranges overriding/adding to the file's ``movable`` ranges (see
         :func:`movable_masses`; floats are m, strings lengths with units).
     carry : mapping of point name to mass key, optional
         Named points that move with a mass.
     method : {"ritz", "fem"}
-        Discretisation (``ritz``: assumed modes, re-assembled incrementally).
+        Discretisation (default :data:`microg.defaults.LAYOUT_METHOD`, ``ritz``: assumed
+        modes, re-assembled incrementally; ``fem`` re-meshes and re-solves every trial).
     plane : {"xz", "yz", "3d"}
+        Default :data:`microg.defaults.PLANE`.
     n : int, optional
         Functions or elements per beam (default: the discretisation's; 1 function is the
         report's model).

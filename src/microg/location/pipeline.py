@@ -310,7 +310,8 @@ def locate(
     direction : str or ndarray (3,), optional
         Force direction (default: the plane's lateral axis, x for xz, y for yz).
     method : {"ritz", "fem"}
-        Assumed modes (the report's method) or 3-D frame elements (stations only).
+        Assumed modes (the report's method) or 3-D frame elements (stations only); default
+        :data:`microg.defaults.METHOD`, as every default here (``plane``, ``zeta``).
     plane : {"xz", "yz", "3d"}
         Ritz: the planar model or the 3-D one; fem and imported models: sets the default
         direction only.

@@ -37,9 +37,9 @@ PLANES = ("3d", "xz", "yz")
 
 def discretize(
     model: Any,
-    method: str = "fem",
+    method: str = defaults.METHOD,
     *,
-    plane: str = "3d",
+    plane: str = defaults.PLANE,
     n: int | None = None,
     gravity_gradient: bool = False,
     constrained: bool = False,

@@ -24,6 +24,7 @@ from typing import Any
 
 import numpy as np
 
+from microg import defaults
 from microg.errors import InputError
 from microg.isolation.active import verify
 from microg.isolation.active.controller import (
@@ -121,7 +122,7 @@ def design_active(
     timepts: np.ndarray | None = None,
     base_accel: np.ndarray | None = None,
     point: str = "mount",
-    requirement: Any = "iss",
+    requirement: Any = defaults.REQUIREMENT,
     freq_hz: np.ndarray | None = None,
     pade_order: int = 3,
 ) -> ActiveIsolation:
