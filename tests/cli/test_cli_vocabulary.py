@@ -217,3 +217,18 @@ def test_locate_force_follows_analyzes_grammar(capsys) -> None:
         assert rc == 0, err
         peaks.append([s["total_peak_g"] for s in json.loads(out)["samples"]])
     assert peaks[1] == pytest.approx([40 / 25 * p for p in peaks[0]], rel=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("args", "now"),
+    [
+        (["locate", "ioc", "--crew", "crew"], "--at"),
+        (["optimize", "ioc", "--experiment", "lab"], "--observe"),
+        (["quasi-steady", "ioc", "--point", "lab"], "--observe"),
+        (["locate", "ioc", "--f0", "40 lbf"], "--force crew-pushoff:f0=..."),
+    ],
+)
+def test_old_option_names_say_the_new_one(capsys, args: list[str], now: str) -> None:
+    rc, out, err = _run(capsys, *args)
+    assert rc == 2 and out == ""
+    assert err == f"microg: error: no such option {args[2]}; it is now {now} (see --help)\n"

@@ -34,6 +34,15 @@ SUBCOMMANDS: dict[str, str] = {
 }
 
 
+#: options renamed to the one vocabulary of the commands: old name -> what to write now
+RENAMED: dict[str, str] = {
+    "--crew": "--at",
+    "--experiment": "--observe",
+    "--point": "--observe",
+    **{f"--{p}": f"--force crew-pushoff:{p}=..." for p in ("f0", "t1", "t13", "t14")},
+}
+
+
 class LazyGroup(click.Group):
     """A click group whose subcommands are imported on demand from :data:`SUBCOMMANDS`."""
 
@@ -124,6 +133,8 @@ def _status(argv: list[str] | None) -> int:
         status = cli.main(args=argv, prog_name="microg", standalone_mode=False)
     except click.exceptions.NoSuchOption as exc:
         hint = f"; did you mean {', '.join(exc.possibilities)}?" if exc.possibilities else ""
+        if exc.option_name in RENAMED:
+            hint = f"; it is now {RENAMED[exc.option_name]}"
         click.echo(f"microg: error: no such option {exc.option_name}{hint} (see --help)", err=True)
         return 2
     except click.exceptions.MissingParameter as exc:
