@@ -206,8 +206,8 @@ def test_builtin_units_agree_with_pint(name: str) -> None:
     # pint's rounding, 1e-15) in every dimension the unit belongs to, 2 pi rules included
     entry = units_module._BUILTIN[name]
     for dimension, dims in units_module._DIMENSION_EXPONENTS.items():
-        if dims != entry[1]:
-            continue
+        if dims != entry[1] or (dimension == "angle" and entry[2] != 1):
+            continue  # a plain ratio (%, ppm) is no angle: refused by design, tested below
         mine = units_module._builtin_conversion(f"{name}^1", dimension)
         theirs = units_module._pint_conversion(f"{name}^1", dimension)
         assert mine is not None
@@ -284,3 +284,18 @@ def test_any_text_is_a_value_or_a_one_line_error(text: str) -> None:
         assert "\n" not in str(exc)
         return
     assert math.isfinite(value)
+
+
+def test_angles_take_deg_or_rad_and_refuse_ratios() -> None:
+    # quasi-steady's --inclination took a bare number of degrees; an angle is now a quantity
+    from microg.units import parse_quantity
+
+    deg = math.pi / 180.0  # the definition of the degree
+    assert parse_quantity("51.6 deg", "angle", where="x") == pytest.approx(51.6 * deg, rel=1e-15)
+    assert parse_quantity("51.6", "angle", where="x", default_unit="deg") == pytest.approx(
+        51.6 * deg, rel=1e-15
+    )
+    assert parse_quantity("1 arcminute", "angle", where="x") == pytest.approx(deg / 60, rel=1e-12)
+    for bad in ("5 %", "5 percent", "3 m/m", "2 rad/s", "51.6 m"):
+        with pytest.raises(InputError):
+            parse_quantity(bad, "angle", where="x")

@@ -464,6 +464,8 @@ def _pint_conversion(canonical: str, dimension: str) -> _Conversion:
         raise _BadQuantityError(
             "has a unit with an offset (a temperature scale)", "use a plain unit"
         )
+    if dimension == "angle" and dict(q1.to_root_units().unit_items()).get("radian", 0) != 1:
+        raise _WrongDimensionError("is not an angle", "use deg or rad, e.g. '51.6 deg'")
     # pint treats the radian as dimensionless, so Hz and rad/s would convert 1:1: convert
     # between cycles and radians explicitly (pint's revolution, rpm and cycle carry 2 pi)
     if dimension in ("angular_frequency", "frequency"):
