@@ -54,11 +54,15 @@ def test_json_contract(capsys):
     assert data["requirement"]["limit_ug"] == pytest.approx(1.0)
 
 
-def test_table_output_and_withheld_verdict(capsys):
+def test_table_output_and_a_fail_certain_without_drag(capsys):
+    # without drag input the lab's 1.41 micro-g from gravity gradient and rotation already
+    # exceeds 1 micro-g: the verdict is a fail, and it says no drag input would change it
     rc, out, err = _run(capsys, "ioc")
     assert rc == 0 and err == ""
-    assert "verdict: withheld" in out and "no drag input" in out
-    assert "lab" in out and "cm" in out
+    assert "verdict: does not comply whatever the drag" in out and "no drag input" in out
+    lab = next(line for line in out.splitlines() if line.strip().startswith("lab "))
+    assert "EXCEEDS whatever the drag (>= 1.41)" in lab
+    assert "cm" in out
 
 
 def test_out_directory(tmp_path, capsys):

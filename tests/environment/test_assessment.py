@@ -133,14 +133,10 @@ def _sinc2_fraction(nb_lo: float, nb_hi: float, off: float) -> float:
     """Power fraction of a tone in a band, from the boxcar kernel written out bin by bin.
 
     A tone ``off`` bins above bin 0 spreads its periodogram power as sinc^2(k - off) over bins
-    k (the Dirichlet kernel of a long record); each bin's power covers [k - 1/2, k + 1/2] and
-    the band is [nb_lo, nb_hi] in bin units.
+    k (the Dirichlet kernel of a long record); the band [nb_lo, nb_hi) in bin units holds
+    the bins k that lie in it (PIMS's band sum).
     """
-    total = 0.0
-    for k in range(-200, 201):
-        overlap = max(0.0, min(nb_hi, k + 0.5) - max(nb_lo, k - 0.5))
-        total += overlap * np.sinc(k - off) ** 2
-    return total
+    return float(sum(np.sinc(k - off) ** 2 for k in range(-200, 201) if nb_lo <= k < nb_hi))
 
 
 def test_five_bins_keep_a_centred_tone_in_its_band():

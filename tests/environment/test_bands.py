@@ -15,10 +15,11 @@ from microg.environment.requirements import BandTable, third_octave_bands
 from microg.environment.spectrum import Spectrum, acceleration_psd
 
 
-def test_band_weights_integrate_the_piecewise_constant_psd_exactly():
-    # independent reference: a plain loop over bins and bands of the overlap length of each
-    # band with each bin [f_k - df/2, f_k + df/2] (clipped to [0, Nyquist]), the DC bin left
-    # out; rounding of a sum of a few thousand terms: 1e-12 relative
+def test_band_weights_sum_the_bins_whose_frequency_lies_in_the_band():
+    # independent reference: a plain loop over bins and bands adding psd_k df of each bin k
+    # >= 1 with lo <= f_k < hi (PIMS's band sum; a band reaching Nyquist also holds the
+    # Nyquist bin, a band from Nyquist up holds nothing); rounding of a sum of a few thousand
+    # terms: 1e-12 relative
     rng = np.random.default_rng(7)
     for nf, df in ((513, 0.05), (1000, 0.013)):
         f = np.arange(nf) * df
@@ -29,12 +30,10 @@ def test_band_weights_integrate_the_piecewise_constant_psd_exactly():
         bands = BandTable(np.sqrt(lo * hi + 1e-9), lo, hi)
         ref = np.zeros((3, lo.size))
         for b in range(lo.size):
-            lo_b, hi_b = min(lo[b], nyq), min(hi[b], nyq)
             for k in range(1, nf):
-                a, c = max(f[k] - df / 2, 0.0), min(f[k] + df / 2, nyq)
-                ov = max(0.0, min(c, hi_b) - max(a, lo_b))
-                if c > a:
-                    ref[:, b] += psd[:, k] * df * ov / (c - a)
+                inside = lo[b] <= f[k] < hi[b] or (hi[b] >= nyq and lo[b] <= f[k] <= nyq)
+                if inside and lo[b] < nyq:
+                    ref[:, b] += psd[:, k] * df
         got = np.asarray(band_weights(f, df, nyq, bands) @ psd.T).T
         np.testing.assert_allclose(got, ref, rtol=1e-12, atol=1e-15 * ref.max())
         spec = Spectrum(f, psd, df, nyq, "periodogram")
@@ -42,6 +41,59 @@ def test_band_weights_integrate_the_piecewise_constant_psd_exactly():
         np.testing.assert_allclose(
             band_rms(spec, bands).rms, np.sqrt(ref[:, keep]), rtol=1e-12, atol=1e-15
         )
+
+
+@pytest.mark.parametrize("where", ["on the lower edge", "beside the lower edge", "mid-band",
+                                   "beside the upper edge", "between two edges"])
+def test_a_tone_on_a_bin_keeps_its_whole_rms_in_one_band(where):
+    """A bin-centred tone's band RMS is its RMS, wherever the band edges fall.
+
+    Reference: the tone's RMS A / sqrt(2) (a sine on a bin of a boxcar record has no leakage,
+    so its whole power is in that one bin).  Edges put on the tone's bin, one bin beside it, or
+    through the bin's interval (0.3 bin above the tone); the neighbouring band gets nothing.
+    Tolerance 1e-12: rounding of the DFT of 30,000 samples.
+    """
+    fs, n, amp = 100.0, 30000, 2.0  # 300 s
+    df = fs / n
+    t = np.arange(n) / fs
+    k = 34  # 0.11333 Hz
+    f0 = k * df
+    shift = {"on the lower edge": 0.0, "beside the lower edge": 1.0, "mid-band": 3.0,
+             "beside the upper edge": 5.0, "between two edges": 0.5}[where]
+    edges = (k - shift + np.array([-6.0, 0.0, 6.0])) * df  # two bands of 6 bins
+    if where == "between two edges":
+        edges = (k + np.array([-6.0, 0.3, 6.3])) * df  # an edge through the tone's bin
+    bands = BandTable(np.sqrt(edges[:-1] * edges[1:]), edges[:-1], edges[1:])
+    x = amp * np.sin(2 * np.pi * f0 * t)
+    ms = band_mean_square(t, x, bands)[0]
+    br = band_rms(acceleration_psd(t, x), bands).rms[0]
+    hold = int(np.searchsorted(edges, f0, side="right") - 1)
+    assert ms[hold] == pytest.approx(amp**2 / 2, rel=1e-12)
+    assert br[hold] == pytest.approx(amp / np.sqrt(2), rel=1e-12)
+    assert ms[1 - hold] <= 1e-20 * amp**2
+
+
+def test_a_band_edge_tone_fails_the_band_it_lies_in():
+    """2.4 micro-g RMS at 0.11333 Hz (a bin of a 300-s record) in the 0.1122-0.1413 Hz band
+    (limit 2.25 micro-g): the band holds all 2.4 micro-g and fails (margin 0.94), and the
+    0.1 Hz band holds none of it.  Reference: the tone's RMS; 1e-9 for the FFT's rounding.
+    """
+    from microg.environment.metrics import assess
+    from microg.units import G0
+
+    fs, n = 100.0, 30000
+    t = np.arange(n) / fs
+    f0 = 34 * fs / n
+    x = np.zeros((3, n))
+    x[0] = 2.4e-6 * G0 * np.sqrt(2) * np.sin(2 * np.pi * f0 * t)
+    res = assess(t, x, transient=None)
+    to = res.third_octave
+    b = int(np.argmin(np.abs(to.center_hz - 0.125)))
+    assert to.lower_hz[b] < f0 < to.upper_hz[b]
+    assert to.rms_g[0, b] == pytest.approx(2.4e-6, rel=1e-9)
+    assert to.margin[0, b] == pytest.approx(to.limit_g[b] / 2.4e-6, rel=1e-9) and to.margin[0, b] < 1
+    assert to.rms_g[0, b - 1] < 1e-6 * 2.4e-6
+    assert res.complies is False
 
 
 @pytest.mark.parametrize("n", [20001, 4096, 1000, 17])

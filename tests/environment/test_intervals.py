@@ -26,16 +26,14 @@ ACCEL = 1e-5 * G0 * RNG.standard_normal((3, N)) + np.array([[2e-6], [0.0], [-1e-
 
 
 def _band_power_loop(freq: np.ndarray, psd: np.ndarray, lo: float, hi: float) -> float:
-    """Bin k's power psd_k df spread over [f_k - df/2, f_k + df/2] within [0, nyq]; no 0 Hz."""
+    """Bin k's power psd_k df where lo <= f_k < hi (every bin up to Nyquist when hi reaches
+    it); no 0 Hz."""
     df = freq[1] - freq[0]
-    nyq = FS / 2  # the last bin of an odd-length record also ends at fs / 2
+    nyq = FS / 2
     total = 0.0
     for k in range(1, freq.size):
-        a = max(freq[k] - df / 2, 0.0)
-        b = min(freq[k] + df / 2, nyq)
-        overlap = max(0.0, min(b, hi) - max(a, lo))
-        if overlap > 0:
-            total += psd[k] * df * overlap / (b - a)
+        if lo <= freq[k] < hi or (hi >= nyq and lo <= freq[k]):
+            total += psd[k] * df
     return total
 
 

@@ -140,12 +140,52 @@ def test_missing_pymsis_falls_back_to_the_exponential_model(monkeypatch, ioc):
     )
 
 
-def test_no_drag_input_withholds_the_verdict(ioc):
+def test_no_drag_input_fails_where_no_drag_can_bring_the_peak_under_the_limit(ioc):
+    # the lab's gravity gradient and rotation alone give 1.41 micro-g (LVLH hold, the lab off
+    # the CM across the flight direction): drag along the flight direction only adds in
+    # quadrature there, so the verdict is a fail without a drag input
     res = quasi_steady(ioc, with_map=False)
-    assert res.complies is None
-    assert all(p.complies is None for p in res.points.values())
+    lab = res.points["lab"]
+    assert np.all(lab.drag_mps2 == 0.0)
+    assert lab.peak_lower_bound_mps2 == pytest.approx(1.4103e-6 * G0, rel=1e-4)
+    assert lab.complies is False and res.complies is False
+    assert any("whatever the drag" in w and "lab" in w for w in res.warnings)
+    assert res.to_dict()["points"]["lab"]["peak_lower_bound_g"] == pytest.approx(1.4103e-6, 1e-4)
+    # the bound holds for every drag (each peak with drag is at least the bound; 1e-12:
+    # rounding) and is reached in the limit of no drag
+    for b in (30.0, 300.0, 3e4):
+        with_drag = quasi_steady(
+            ioc, drag=Drag(ballistic_coefficient_kg_per_m2=b), with_map=False
+        ).points
+        for name, p in res.points.items():
+            assert with_drag[name].peak_magnitude_mps2 >= p.peak_lower_bound_mps2 * (1 - 1e-12)
+            assert with_drag[name].complies is not True or p.complies is not False
+
+
+def test_no_drag_input_withholds_the_verdict_where_drag_could_decide(ioc):
+    # at the CM the drag-free terms vanish: the bound is 0 and the verdict stays open
+    res = quasi_steady(ioc, points=[], with_map=False)
+    assert res.points["cm"].peak_lower_bound_mps2 == 0.0
+    assert res.complies is None and res.points["cm"].complies is None
     assert any("verdict is withheld" in w for w in res.warnings)
-    assert np.all(res.points["lab"].drag_mps2 == 0.0)
+
+
+def test_peak_lower_bound_against_a_search_over_the_drag_size():
+    # reference: for each sample, min over a fine grid of drag sizes k >= 0 of |q + k u|,
+    # then the largest over the samples; the grid's step (1e-4 of |q|) bounds the error to
+    # ~1e-8 relative (a quadratic minimum)
+    rng = np.random.default_rng(3)
+    q = rng.standard_normal((4, 7, 3))
+    u = rng.standard_normal((7, 3))
+    u /= np.linalg.norm(u, axis=1, keepdims=True)
+    k = np.linspace(0.0, 10.0, 100_001)
+    ref = np.array(
+        [
+            max(np.min(np.linalg.norm(q[p, s] + k[:, None] * u[s], axis=1)) for s in range(7))
+            for p in range(4)
+        ]
+    )
+    np.testing.assert_allclose(qs.peak_lower_bound(q, u), ref, rtol=1e-7)
 
 
 def test_center_of_mass_and_parts(ioc):

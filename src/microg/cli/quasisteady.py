@@ -376,6 +376,8 @@ def _summary(result: Any, out_dir: Path | None) -> None:
     for name, p in result.points.items():
         a = p.accel_mps2 * ug
         verdict = {True: "complies", False: "EXCEEDS", None: "withheld"}[p.complies]
+        if p.complies is False and p.peak_lower_bound_mps2 is not None:
+            verdict += f" whatever the drag (>= {p.peak_lower_bound_mps2 * ug:.3g})"
         click.echo(
             f"{name:>14} {p.position_m[0]:8.3g} {p.position_m[1]:8.3g} {p.position_m[2]:8.3g}  "
             f"{a[0]:9.3g} {a[1]:9.3g} {a[2]:9.3g} {p.peak_magnitude_mps2 * ug:9.3g}  {verdict}"
@@ -392,6 +394,8 @@ def _summary(result: Any, out_dir: Path | None) -> None:
             )
         )
     overall = {True: "complies", False: "does not comply", None: "withheld"}[result.complies]
+    if result.complies is False and result.drag.beta(result.mass_kg) is None:
+        overall += " whatever the drag (no drag input needed)"
     click.echo(f"verdict: {overall}")
     for w in result.warnings:
         click.echo(f"warning: {w}")

@@ -1,11 +1,12 @@
 """Band RMS of a spectrum: the band integration, its resolution rule, and its fast path.
 
-Band RMS (see docs/assessment.md): ``sqrt(integral of the PSD over [lower, upper])``.  Each
-frequency bin's power ``psd_k * df`` is spread uniformly over its own interval
-``[f_k - df/2, f_k + df/2]`` (clipped to ``[0, Nyquist]``); a bin straddling a band edge is
-shared in proportion.  So the band mean squares of contiguous bands add up exactly to the
-mean square of the record in their range (Parseval).  Bands wholly above Nyquist are left
-out, and the power of the 0-Hz bin (the mean) is excluded from every band.
+Band RMS (see docs/assessment.md): ``sqrt(sum of psd_k * df over the bins in the band)``, the
+band sum of NASA PIMS: a frequency bin belongs wholly to the band its frequency ``f_k`` lies
+in (``lower <= f_k < upper``; a bin on an edge belongs to the band above it, a band reaching
+Nyquist also holds the Nyquist bin).  A tone on a bin therefore keeps its whole power in
+one band wherever the band edges fall, and the band mean squares of contiguous bands add up
+exactly to the mean square of the record in their range (Parseval).  Bands wholly above
+Nyquist are left out, and the power of the 0-Hz bin (the mean) is excluded from every band.
 
 Resolved band: at least ``MIN_BINS`` (5) frequency bins in the band, a record at least
 ``MIN_TIME_BANDWIDTH`` (5) times 1/bandwidth long, wholly below Nyquist (and below the data's
@@ -97,10 +98,12 @@ class BandRMS:
 def band_weights(freq_hz: np.ndarray, df_hz: float, nyquist_hz: float, bands: BandTable) -> Any:
     """The band integration as a linear map: ``power_b = sum_k W[b, k] psd_k``, Hz.
 
-    Bin ``k`` covers ``[f_k - df/2, f_k + df/2]`` clipped to ``[0, nyquist]`` and carries
-    ``psd_k df``; a band ``[lo, hi]`` (clipped to Nyquist) takes the fraction of each bin it
-    overlaps (the PSD constant across a bin), and the 0-Hz bin's power (the mean) is left out.
-    ``W[b, k] = df |[lo, hi] ∩ bin_k| / |bin_k|``.  Sparse: each band covers a run of bins.
+    Bin ``k`` carries ``psd_k df`` and belongs wholly to the band its frequency lies in:
+    ``W[b, k] = df`` when ``lo_b <= f_k < hi_b`` (a band reaching Nyquist also holds the
+    Nyquist bin; a bin on an edge, to ``EDGE_RTOL``, belongs to the band above), else 0.  The
+    0-Hz bin's power (the mean) is left out.  This is PIMS's band sum: a tone on a bin keeps
+    its whole power in one band wherever the band edges fall.  Sparse: each band holds a run
+    of bins.
     The last few maps are kept (a run judges many series on one grid and band table) and
     shared, so they are read-only.
 
@@ -149,25 +152,38 @@ def _band_weights(
     import scipy.sparse as sp
 
     nb = lower_hz.size
-    edges = np.r_[0.0, np.minimum(f + df_hz / 2, nyquist_hz)]
-    lo = np.minimum(lower_hz, nyquist_hz)
-    hi = np.minimum(upper_hz, nyquist_hz)
-    # bins j0 <= j < j1 overlap [lo, hi]
-    j0 = np.clip(np.searchsorted(edges, lo, side="right") - 1, 0, f.size)
-    j1 = np.clip(np.searchsorted(edges, hi, side="left"), 0, f.size)
-    j1 = np.maximum(j1, j0)
+    lo, hi = _member_edges(lower_hz, upper_hz, nyquist_hz)
+    # bins j0 <= j < j1 lie in [lo, hi): their frequencies are sorted
+    j0 = np.searchsorted(f, lo, side="left")
+    j1 = np.maximum(np.searchsorted(f, hi, side="left"), j0)
+    if f.size and f[0] == 0.0:
+        j0 = np.maximum(j0, 1)  # the mean is no vibration
+        j1 = np.maximum(j1, j0)
     count = j1 - j0
     rows = np.repeat(np.arange(nb), count)
     cols = np.repeat(j0 - np.cumsum(np.r_[0, count[:-1]]), count) + np.arange(int(count.sum()))
-    a, b = edges[cols], edges[cols + 1]
-    width = b - a
-    overlap = np.minimum(b, hi[rows]) - np.maximum(a, lo[rows])
-    with np.errstate(invalid="ignore", divide="ignore"):
-        frac = np.where(width > 0, np.clip(overlap, 0.0, None) / width, 0.0)
-    w = frac * df_hz
-    if f.size and f[0] == 0.0:
-        w = np.where(cols == 0, 0.0, w)  # the mean is no vibration
+    w = np.full(cols.size, float(df_hz))
     return sp.csr_matrix((w, (rows, cols)), shape=(nb, f.size))
+
+
+#: relative tolerance of the band-membership test: a bin whose frequency is a band edge to
+#: rounding belongs to the band that the edge starts
+EDGE_RTOL = 1e-9
+
+
+def _member_edges(
+    lower_hz: np.ndarray, upper_hz: np.ndarray, nyquist_hz: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """The half-open interval ``[lo, hi)`` of bin frequencies each band holds, Hz.
+
+    Edges are moved down by ``EDGE_RTOL`` so that a bin on an edge (to rounding) belongs to
+    the band above it; a band reaching Nyquist or past it also holds the Nyquist bin.
+    """
+    lo = np.asarray(lower_hz, float) * (1.0 - EDGE_RTOL)
+    hi = np.asarray(upper_hz, float) * (1.0 - EDGE_RTOL)
+    hi = np.where(np.asarray(upper_hz, float) >= nyquist_hz * (1.0 - EDGE_RTOL), np.inf, hi)
+    lo = np.where(np.asarray(lower_hz, float) >= nyquist_hz, np.inf, lo)  # wholly above
+    return lo, hi
 
 
 #: direct DFT of the bins a band table needs, instead of the whole FFT, up to this many bins

@@ -10,11 +10,11 @@ Definitions (see docs/assessment.md):
   exactly: ``sum(psd) * df`` is the mean square).  ``welch``: Hann window, segments of
   ``segment_s`` (default the whole record), 50 % overlap, each segment's mean removed; for long
   stationary records.
-* Band RMS: ``sqrt(integral of the PSD over [lower, upper])``.  Each frequency bin's power
-  ``psd_k * df`` is spread uniformly over its own interval ``[f_k - df/2, f_k + df/2]`` (clipped to
-  ``[0, Nyquist]``); a bin straddling a band edge is shared in proportion.  So the band mean
-  squares of contiguous bands add up exactly to the mean square of the record in their range
-  (Parseval).  Bands wholly above Nyquist are left out.
+* Band RMS: ``sqrt(sum of psd_k * df over the bins in the band)`` (PIMS's band sum): a bin
+  belongs wholly to the band its frequency lies in (``lower <= f_k < upper``), so a tone on a
+  bin keeps its whole power in one band, and the band mean squares of contiguous bands add up
+  exactly to the mean square of the record in their range (Parseval).  Bands wholly above
+  Nyquist are left out.
 * Resolved band: at least ``MIN_BINS`` (5) frequency bins in the band, a record at least
   ``MIN_TIME_BANDWIDTH`` (5) times 1/bandwidth long, wholly below Nyquist (and below the data's
   anti-alias cutoff when one is given).  Only resolved bands are judged; the others are listed

@@ -51,8 +51,10 @@ in time, giving orbital averages (of each vector, in the station and the LVLH fr
 
 Compliance is judged against the ISS quasi-steady requirement, 1 micro-g at internal payload
 locations (NASA-CR-205357; ``microg/data/quasi_steady_requirement.toml``), on the peak
-magnitude over the orbit.  Without a drag input (ballistic coefficient, or area and C_d) the
-verdict is withheld (``complies`` None) and a warning says so.
+magnitude over the orbit.  Without a drag input (ballistic coefficient, or area and C_d) a
+point fails when the smallest peak any drag could give (:func:`peak_lower_bound`: drag along
+its known direction, of any size) already exceeds the limit; otherwise its verdict is withheld
+(``complies`` None), and a warning says which.
 
 Modules, one concept each: :mod:`~microg.environment.gravity_gradient` (the tidal term),
 :mod:`~microg.environment.attitude` (attitudes and the rotation term),
@@ -132,6 +134,7 @@ __all__ = [
     "geodetic",
     "gravity_gradient_accel",
     "orbit_samples",
+    "peak_lower_bound",
     "peak_magnitude",
     "quasi_steady",
     "quasi_steady_requirement",
@@ -192,8 +195,10 @@ class PointQuasiSteady:
 
     Vectors are orbital averages in the station frame, with ``*_lvlh`` the same in LVLH.
     ``magnitude_mps2`` is the magnitude of the average vector, ``peak_magnitude_mps2`` the
-    largest magnitude over the orbit (what the requirement judges), ``complies`` the verdict
-    (None when withheld: no drag input).
+    largest magnitude over the orbit (what the requirement judges), ``complies`` the verdict.
+    Without a drag input ``peak_lower_bound_mps2`` is the smallest peak any drag could give
+    (:func:`peak_lower_bound`): above the limit the point fails whatever the drag, else its
+    verdict is withheld (None).
     """
 
     name: str
@@ -210,6 +215,7 @@ class PointQuasiSteady:
     magnitude_mps2: float
     peak_magnitude_mps2: float
     complies: bool | None
+    peak_lower_bound_mps2: float | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """The contract's entry (vectors in g, station frame and LVLH)."""
@@ -230,6 +236,9 @@ class PointQuasiSteady:
                 "drag_g": (self.drag_lvlh_mps2 * g).tolist(),
             },
             "complies": self.complies,
+            "peak_lower_bound_g": None
+            if self.peak_lower_bound_mps2 is None
+            else self.peak_lower_bound_mps2 * g,
         }
 
 
@@ -502,6 +511,33 @@ def peak_magnitude(static: np.ndarray, varying: np.ndarray) -> np.ndarray:
     return np.sqrt(np.maximum(out, 0.0))
 
 
+def peak_lower_bound(static: np.ndarray, direction: np.ndarray) -> np.ndarray:
+    """The smallest peak magnitude over the orbit that any drag can give, m/s^2, (P,).
+
+    Drag acts along a known direction ``u_s`` (against the wind relative to the co-rotating
+    atmosphere) with an unknown size ``k_s >= 0`` at each sample (ballistic coefficient,
+    density and solar activity unknown).  At one sample ``min_{k >= 0} |q + k u| = |q|`` when
+    ``q . u >= 0`` (drag can only add), else ``|q - (q . u) u|`` (drag cancels the along-wind
+    part at best).  Each sample's minimum is reached by its own ``k_s``, so the bound is the
+    largest over the samples: ``max_s min_k |q_s + k u_s|`` <= the peak for every drag.
+
+    Parameters
+    ----------
+    static : (P, S, 3) or (P, 3) the drag-free acceleration (gravity gradient and rotation) at
+        each point and sample, m/s^2
+    direction : (S, 3) unit vectors of the drag at each sample (rows of zeros: no drag there)
+    """
+    u = np.asarray(direction, float)
+    q = np.asarray(static, float)
+    if q.ndim == 2:
+        q = q[:, None, :]
+    q = np.broadcast_to(q, (q.shape[0], u.shape[0], 3))
+    qu = np.einsum("psi,si->ps", q, u)
+    q2 = np.sum(q * q, axis=-1)
+    low2 = np.where(qu >= 0.0, q2, q2 - qu * qu)
+    return np.sqrt(np.maximum(low2, 0.0).max(axis=1))
+
+
 def _map_peaks(
     positions: np.ndarray,
     cm: np.ndarray,
@@ -644,8 +680,9 @@ def quasi_steady(
     if beta is None:
         drag_s = np.zeros((samples.time_s.size, 3))
         warnings.append(
-            "no drag input (ballistic coefficient, or area and Cd): drag is left out and the "
-            "verdict is withheld (complies = null)"
+            "no drag input (ballistic coefficient, or area and Cd): drag is left out; a point "
+            "fails only if it exceeds the limit whatever the drag, else its verdict is "
+            "withheld (complies = null)"
         )
     else:
         drag_s = drag_accel(rho_atm, samples.v_rel_mps, beta)
@@ -681,10 +718,19 @@ def quasi_steady(
         return np.einsum("sij,psj->pi", L, v) / S
 
     peaks = np.sqrt(np.max(np.sum(total * total, axis=-1), axis=1))
+    lower = None
+    if beta is None:  # drag unknown: the smallest peak any drag could give
+        d_dir = drag_accel(rho_atm, samples.v_rel_mps, 1.0)
+        d_len = np.linalg.norm(d_dir, axis=1, keepdims=True)
+        d_dir = np.divide(d_dir, d_len, out=np.zeros_like(d_dir), where=d_len > 0)
+        lower = peak_lower_bound(gg_s + rot_s, d_dir)
     out_points: dict[str, PointQuasiSteady] = {}
     for i, (pname, kind, p) in enumerate(chosen):
         mean = total[i].mean(axis=0)
-        verdict = None if beta is None else bool(peaks[i] <= limit)
+        if lower is None:
+            verdict: bool | None = bool(peaks[i] <= limit)
+        else:
+            verdict = False if lower[i] > limit else None
         out_points[pname] = PointQuasiSteady(
             name=pname,
             kind=kind,
@@ -700,6 +746,7 @@ def quasi_steady(
             magnitude_mps2=float(np.linalg.norm(mean)),
             peak_magnitude_mps2=float(peaks[i]),
             complies=verdict,
+            peak_lower_bound_mps2=None if lower is None else float(lower[i]),
         )
     # the verdict: payload (experiment) points if the model names any, else every named point
     judged = [c[0] for c in chosen if c[1] == "experiment"] or [c[0] for c in chosen[1:]]
@@ -707,7 +754,19 @@ def quasi_steady(
         judged = ["cm"]
         warnings.append("the model names no points: only the centre of mass is judged")
     if beta is None:
-        overall: bool | None = None
+        fails = [n_ for n_ in judged if out_points[n_].complies is False]
+        overall: bool | None = False if fails else None
+        if fails:
+            warnings.append(
+                "without drag input the verdict is a fail: at "
+                + ", ".join(
+                    f"{n_} (>= {out_points[n_].peak_lower_bound_mps2 / G0 * 1e6:.3g} micro-g)"
+                    for n_ in fails
+                )
+                + f" gravity gradient and rotation exceed {req.limit_g * 1e6:.3g} micro-g "
+                "whatever the drag (no ballistic coefficient, area, Cd, density or solar "
+                "activity changes it)"
+            )
     else:
         overall = all(out_points[n_].complies for n_ in judged)
     qmap = None
