@@ -327,3 +327,20 @@ def test_map_with_varying_gradient_equals_the_points(ioc, attitude):
     ref = np.array([p.peak_magnitude_mps2 for p in res.points.values()])
     # two exact forms of the same sum: rounding only (terms ~ n^2 |rho| add without cancelling)
     np.testing.assert_allclose(pk, ref, rtol=1e-11)
+
+
+def test_map_csv_quotes_labels_with_commas():
+    # a label with a comma ("main/Horizontal lab, SAA0207 and SAA0201") gave its row an extra
+    # column; reference: the csv module's reader gives back the six fields and the label
+    labels = ("main/Horizontal lab, SAA0207 and SAA0201", 'say "x"', "plain")
+    pos = np.array([[1.0, 2.0, 3.0], [0.0, 0.0, 0.0], [-1.5, 0.25, 1e-3]])
+    peak = np.array([1.2, 0.5, 2.0]) * 1e-6 * G0
+    m = qs.QuasiSteadyMap(pos, labels, peak, 1e-6 * G0, peak <= 1e-6 * G0, None)
+    import csv
+    import io
+
+    rows = list(csv.reader(io.StringIO(m.to_csv())))
+    assert rows[0] == ["label", "x [m]", "y [m]", "z [m]", "peak [ug]", "within_limit"]
+    assert [r[0] for r in rows[1:]] == list(labels)
+    assert all(len(r) == 6 for r in rows)
+    assert rows[1][1:] == ["1", "2", "3", "1.2", "false"]

@@ -66,6 +66,8 @@ requirement) and keeps their names importable from here.
 
 from __future__ import annotations
 
+import csv
+import io
 import math
 import tomllib
 from collections.abc import Mapping, Sequence
@@ -290,15 +292,21 @@ class QuasiSteadyMap:
         }
 
     def to_csv(self) -> str:
-        """The map as CSV: label, x, y, z (m), peak magnitude (micro-g), within the limit."""
-        lines = ["label,x [m],y [m],z [m],peak [ug],within_limit"]
+        """The map as CSV: label, x, y, z (m), peak magnitude (micro-g), within the limit.
+
+        Written by the :mod:`csv` module, so a label holding a comma or a quote is quoted.
+        """
+        buf = io.StringIO()
+        out = csv.writer(buf, lineterminator="\n")
+        out.writerow(["label", "x [m]", "y [m]", "z [m]", "peak [ug]", "within_limit"])
         for lab, p, a, w in zip(
             self.labels, self.positions_m, self.peak_magnitude_mps2, self.within, strict=True
         ):
-            lines.append(
-                f"{lab},{p[0]:.6g},{p[1]:.6g},{p[2]:.6g},{a / G0 * 1e6:.6g},{str(bool(w)).lower()}"
-            )
-        return "\n".join(lines) + "\n"
+            out.writerow(
+                [lab, f"{p[0]:.6g}", f"{p[1]:.6g}", f"{p[2]:.6g}", f"{a / G0 * 1e6:.6g}",
+                 str(bool(w)).lower()]
+            )  # fmt: skip
+        return buf.getvalue()
 
 
 @dataclass(frozen=True)
