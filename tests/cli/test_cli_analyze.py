@@ -276,3 +276,31 @@ def test_the_process_writes_the_librarys_figures(tmp_path: Path) -> None:
     for name, png in want.items():
         assert written[name] == png, name
     assert json.loads(proc.stdout) == json.loads((out / "results.json").read_text())
+
+
+def test_console_gives_one_verdict_line_per_criterion(tmp_path: Path, capsys) -> None:
+    # a 20-s record: the judged bands comply, unresolved bands exceed (undecided), the
+    # unverified integrated-acceleration criterion and the seed report's 1e-5 g are exceeded
+    # (reported only).  No line may read as a pass beside a criterion it does not judge.
+    rc, out, err = _run(
+        capsys,
+        ["analyze", "--duration", "20", "--observe", "lab", "--out", str(tmp_path / "o"),
+         "--no-progress"],
+    )  # fmt: skip
+    assert rc == 0, err
+    lines = out.splitlines()
+    head = next(line for line in lines if line.startswith("  lab: "))
+    assert head.startswith("  lab: DOES NOT COMPLY with iss")
+    assert "ABOVE" not in out and "complies without isolation" not in out
+    crit = [line.strip() for line in lines if line.startswith("    ") and "isolation" not in line]
+    names = [c.split(":")[0] for c in crit]
+    d = json.loads((tmp_path / "o" / "results.json").read_text())["observations"]["lab"]
+    assert names == [c["name"] for c in d["criteria"]]  # one line per criterion, same order
+    by = dict(zip(names, crit, strict=True))
+    assert by["iss bands"].startswith("iss bands: complies (margin ")
+    assert by["iss unresolved bands"].startswith("iss unresolved bands: undecided: ")
+    assert "reported only: FAILS" in by["integrated-10ug-s-per-axis-10s"]
+    assert "reported only: FAILS" in by["report peak 1e-5 g"]
+    iso = next(line for line in lines if line.startswith("    isolation: "))
+    assert iso.startswith("    isolation: undecided: ") and "peak limit" not in iso
+    assert d["isolation"]["status"] == "undecided" and d["peak_limit_g"] is None

@@ -43,8 +43,16 @@ def test_band_weights_sum_the_bins_whose_frequency_lies_in_the_band():
         )
 
 
-@pytest.mark.parametrize("where", ["on the lower edge", "beside the lower edge", "mid-band",
-                                   "beside the upper edge", "between two edges"])
+@pytest.mark.parametrize(
+    "where",
+    [
+        "on the lower edge",
+        "beside the lower edge",
+        "mid-band",
+        "beside the upper edge",
+        "between two edges",
+    ],
+)
 def test_a_tone_on_a_bin_keeps_its_whole_rms_in_one_band(where):
     """A bin-centred tone's band RMS is its RMS, wherever the band edges fall.
 
@@ -58,8 +66,13 @@ def test_a_tone_on_a_bin_keeps_its_whole_rms_in_one_band(where):
     t = np.arange(n) / fs
     k = 34  # 0.11333 Hz
     f0 = k * df
-    shift = {"on the lower edge": 0.0, "beside the lower edge": 1.0, "mid-band": 3.0,
-             "beside the upper edge": 5.0, "between two edges": 0.5}[where]
+    shift = {
+        "on the lower edge": 0.0,
+        "beside the lower edge": 1.0,
+        "mid-band": 3.0,
+        "beside the upper edge": 5.0,
+        "between two edges": 0.5,
+    }[where]
     edges = (k - shift + np.array([-6.0, 0.0, 6.0])) * df  # two bands of 6 bins
     if where == "between two edges":
         edges = (k + np.array([-6.0, 0.3, 6.3])) * df  # an edge through the tone's bin
@@ -91,7 +104,8 @@ def test_a_band_edge_tone_fails_the_band_it_lies_in():
     b = int(np.argmin(np.abs(to.center_hz - 0.125)))
     assert to.lower_hz[b] < f0 < to.upper_hz[b]
     assert to.rms_g[0, b] == pytest.approx(2.4e-6, rel=1e-9)
-    assert to.margin[0, b] == pytest.approx(to.limit_g[b] / 2.4e-6, rel=1e-9) and to.margin[0, b] < 1
+    assert to.margin[0, b] == pytest.approx(to.limit_g[b] / 2.4e-6, rel=1e-9)
+    assert to.margin[0, b] < 1
     assert to.rms_g[0, b - 1] < 1e-6 * 2.4e-6
     assert res.complies is False
 

@@ -18,6 +18,7 @@ from microg.analysis.options import REPORT_LIMIT_G, AnalysisOptions, Disturbance
 from microg.dynamics.modes import Modes
 from microg.dynamics.peaks import PeakResponse
 from microg.dynamics.response import PointResponse
+from microg.environment.criteria import CriterionVerdict
 from microg.environment.metrics import Assessment
 from microg.environment.requirements import Requirement
 from microg.isolation.advise import IsolationAdvice
@@ -26,7 +27,31 @@ from microg.structure.structure import Structure
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-__all__ = ["Analysis", "Observation"]
+__all__ = ["Analysis", "Observation", "report_criterion"]
+
+#: the seed report's criterion, cited (the ``report-1e-5g`` transient set has the same limit)
+REPORT_SOURCE = "seed report, Introduction: experiments require acceleration below 1e-5 g"
+
+
+def report_criterion(a: Assessment) -> CriterionVerdict:
+    """The seed report's 1e-5 g peak as a reported-only criterion (not the one judged).
+
+    Parameters
+    ----------
+    a : the point's assessment (its ``peak_accel_g``, g)
+    """
+    peak = float(a.peak_accel_g)
+    return CriterionVerdict(
+        "report peak 1e-5 g",
+        "reported",
+        peak <= REPORT_LIMIT_G,
+        float("inf") if peak <= 0 else REPORT_LIMIT_G / peak,
+        peak,
+        REPORT_LIMIT_G,
+        "g",
+        REPORT_SOURCE,
+        f"the seed report's figure, shown for comparison; the verdict is {a.requirement}'s",
+    )
 
 
 @dataclass(frozen=True)
@@ -59,6 +84,11 @@ class Observation:
     peak: PeakResponse | None = None
 
     @property
+    def criteria(self) -> tuple[CriterionVerdict, ...]:
+        """The assessment's criteria, then the seed report's 1e-5 g (reported only)."""
+        return (*self.assessment.criteria, report_criterion(self.assessment))
+
+    @property
     def peak_accel_g(self) -> float:
         """Peak of the acceleration magnitude, g."""
         return float(self.assessment.peak_accel_g)
@@ -75,6 +105,7 @@ class Observation:
             "limit_g": REPORT_LIMIT_G,
             "peak_within": bool(self.assessment.peak_accel_g <= REPORT_LIMIT_G),
         }
+        d["criteria"] = [c.to_dict() for c in self.criteria]
         d["requirement_interval"] = dict(self.interval)
         if self.peak is not None:
             d["peak"] = self.peak.to_dict()

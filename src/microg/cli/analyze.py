@@ -367,8 +367,8 @@ def write_outputs(result: Any, out_dir: Path, *, static: bool = False) -> tuple[
 
 
 def summary(result: Any, path: Path) -> None:
-    """The console summary: modes, each point's verdicts, isolation, warnings."""
-    from microg.analysis import REPORT_LIMIT_G
+    """The console summary: modes, each point's verdict per criterion, isolation, warnings."""
+    from microg.analysis.result import report_criterion
 
     m = result.modes
     el = (m.omega > 0) & result.used
@@ -381,12 +381,13 @@ def summary(result: Any, path: Path) -> None:
     for name, ob in result.observations.items():
         a = ob.assessment
         verdict = "complies" if a.complies else "DOES NOT COMPLY"
-        flat = "within" if a.peak_accel_g <= REPORT_LIMIT_G else "ABOVE"
         click.echo(
-            f"  {name}: peak {a.peak_accel_g:.3g} g ({flat} the report's {REPORT_LIMIT_G:g} g), "
-            f"RMS {a.rms_accel_g:.3g} g, {verdict} with {a.requirement}"
+            f"  {name}: {verdict} with {a.requirement} (the judged criteria below; peak "
+            f"{a.peak_accel_g:.3g} g, RMS {a.rms_accel_g:.3g} g)"
         )
-        click.echo(f"    isolation: {ob.isolation.note}")
+        for c in (*a.criteria, report_criterion(a)):
+            click.echo(f"    {c.line()}")
+        click.echo(f"    isolation: {ob.isolation.status}: {ob.isolation.note}")
     fd = result.frequency_domain
     if fd is not None:
         click.echo(f"  frequency domain ({len(fd.sources)} sources, {fd.requirement}):")

@@ -20,6 +20,7 @@ import numpy as np
 from microg._json import json_numbers
 from microg.environment._samples import as_axes, check_finite
 from microg.environment.bands import MIN_BINS, MIN_TIME_BANDWIDTH, band_rms
+from microg.environment.criteria import CriterionVerdict, criterion_verdicts
 from microg.environment.integrated import (
     IntegratedAcceleration,
     IntegratedBlocks,
@@ -123,6 +124,14 @@ class Assessment:
         """The bands left out of the verdict: centre, edges and why."""
         return self.third_octave.unresolved_bands
 
+    @property
+    def criteria(self) -> tuple[CriterionVerdict, ...]:
+        """One verdict per criterion: judged, reported only or undecided.
+
+        See :mod:`microg.environment.criteria`; ``complies`` is ``verdict_complies`` of these.
+        """
+        return criterion_verdicts(self)
+
     # ---------------------------------------------------------------------------- outputs
 
     def to_dict(self) -> dict[str, Any]:
@@ -170,6 +179,7 @@ class Assessment:
             "transient": None
             if self.transient is None
             else {"basis": self.transient_basis, **self.transient.to_dict(ax)},
+            "criteria": [c.to_dict() for c in self.criteria],
             "warnings": list(self.warnings),
         }
         pb = self.integrated_pims

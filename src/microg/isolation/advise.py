@@ -2,23 +2,32 @@
 
 The policy, in order:
 
-1. A point that complies needs nothing (``status = "not-needed"``).
-2. A point that fails only a peak limit (no band exceeds) cannot be helped by a passive mount
-   without the transient's spectrum (``"peak-only"``).
-3. Otherwise the exceeding bands give the attenuation needed, band by band (1 / margin).  The
+Each status follows from the assessment's criteria (:attr:`Assessment.criteria
+<microg.environment.assessment.Assessment.criteria>`):
+
+1. A point that complies needs nothing (``status = "not-needed"``); the note names any
+   reported-only criterion exceeded (it does not enter the verdict).
+2. No resolved band exceeds, but the record cannot decide: no band resolved, or unresolved
+   bands whose estimates exceed their limits (``"undecided"``): the note says what record
+   would decide; no mount is sized from bands the record does not resolve.
+3. No resolved band exceeds and the requirement's own peak limit is exceeded
+   (``"peak-only"``): a passive mount cannot help a transient's peak without its spectrum.
+   A verified transient criterion exceeded, no band and no peak limit exceeded
+   (``"transient-only"``): likewise.
+4. Otherwise the exceeding bands give the attenuation needed, band by band (1 / margin).  The
    report's rule (Section 4.2, :func:`~microg.isolation.design.design_mount`) sizes a mount for
    ``M_a <= target`` over the exceeding band; its undamped resonance is excited by a transient
    below that band, so spring-damper mounts are also screened on the whole spectrum
    (:func:`~microg.isolation.mount.search_mount`).  The screened choice (or, when none
    complies, the report-rule design) is verified with the exact time-domain response of the
    package (:func:`~microg.isolation.timedomain.package_response`).
-4. A mount is **recommended** only when that time-domain check complies and the record can
+5. A mount is **recommended** only when that time-domain check complies and the record can
    see the mount's resonance (its natural frequency lies in a band the record resolves;
    otherwise the advice names the record length needed) (``"passive-mount"``).  Otherwise no
    passive mount in the screen complies (``"no-passive-mount"``): the advice says so, gives
    the attenuation needed per band, and that active isolation is needed.  A design that
    fails its own check is never recommended.
-5. When no passive mount is recommended, the default active isolator (the ``aris`` preset,
+6. When no passive mount is recommended, the default active isolator (the ``aris`` preset,
    :func:`~microg.isolation.active.design.design_active`) is designed for the attenuation
    asked per band and verified on the same response: stable, margins kept, the platform's
    band verdict (sensor noise included) compliant, stroke and force within their limits.  Only
@@ -53,7 +62,9 @@ __all__ = ["IsolationAdvice", "advise_isolation", "STATUSES"]
 STATUSES = (
     "not-assessed",
     "not-needed",
+    "undecided",
     "peak-only",
+    "transient-only",
     "passive-mount",
     "no-passive-mount",
     "no-design",
@@ -334,6 +345,48 @@ def _active_check(
     )
 
 
+def _without_bands(point: str, assessment: Assessment) -> IsolationAdvice:
+    """The advice when no resolved band exceeds: which criterion decides (module doc, 1-3)."""
+    crit = assessment.criteria
+    reported = [c for c in crit if c.status == "reported" and not c.complies]
+    tail = (
+        "; reported only (not in the verdict): "
+        + ", ".join(f"{c.name} exceeded (margin {c.margin:.3g})" for c in reported)
+        if reported
+        else ""
+    )
+    if assessment.complies:
+        return IsolationAdvice(
+            point, "not-needed", note=f"every judged criterion complies without isolation{tail}"
+        )
+    undecided = [c for c in crit if c.status == "undecided"]
+    failed = [c for c in crit if c.status == "judged" and c.complies is False]
+    peak = [c for c in failed if c.name == f"{assessment.requirement} peak"]
+    if peak:
+        return IsolationAdvice(
+            point,
+            "peak-only",
+            note=f"no resolved band exceeds; the requirement's peak limit is exceeded (margin "
+            f"{peak[0].margin:.3g}): a passive mount cannot help a transient's peak without "
+            f"knowing its spectrum{tail}",
+        )
+    if failed:
+        names = ", ".join(f"{c.name} (margin {c.margin:.3g})" for c in failed)
+        return IsolationAdvice(
+            point,
+            "transient-only",
+            note=f"no resolved band exceeds; the transient criteria {names} are exceeded: a "
+            f"passive mount is not sized from a transient criterion{tail}",
+        )
+    why = "; ".join(c.why for c in undecided)
+    return IsolationAdvice(
+        point,
+        "undecided",
+        note=f"no resolved band exceeds, but the record cannot decide ({why}); isolation is "
+        f"not sized from bands the record does not resolve{tail}",
+    )
+
+
 def advise_isolation(
     point: str,
     assessment: Assessment,
@@ -364,19 +417,12 @@ def advise_isolation(
     from microg.isolation.mount import search_mount
     from microg.isolation.timedomain import IsolatorModel, package_responses
 
-    if assessment.complies:
-        return IsolationAdvice(point, "not-needed", note="complies without isolation")
     to = assessment.third_octave
     margin = to.margin.min(axis=0)
     resolved = np.asarray(getattr(to, "resolved", np.ones(margin.shape, bool)), bool)
     bad = np.isfinite(margin) & (margin < 1.0) & resolved
-    if not np.any(bad):
-        return IsolationAdvice(
-            point,
-            "peak-only",
-            note="exceeds the peak limit only: a passive mount cannot help a transient's peak "
-            "without knowing its spectrum",
-        )
+    if assessment.complies or not np.any(bad):
+        return _without_bands(point, assessment)
     need = {float(c): float(1.0 / mm) for c, mm in zip(to.center_hz[bad], margin[bad], strict=True)}
     edges = {
         float(c): (float(a), float(b))
