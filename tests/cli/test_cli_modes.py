@@ -101,7 +101,8 @@ def test_table(capsys):
     rc, out, _ = _run(capsys, "ioc", "--method", "ritz", "--plane", "xz")
     assert rc == 0
     assert "omega (rad/s)" in out and "f (Hz)" in out and "eff x %" in out
-    assert len(out.strip().splitlines()) == 2 + 5
+    assert len(out.strip().splitlines()) == 2 + 5 + 1  # header lines, modes, modal mass
+    assert out.strip().splitlines()[-1].startswith("  modal mass: shape scaled to")
 
 
 @pytest.mark.parametrize(

@@ -220,6 +220,17 @@ def modes(
         row = f"{j + 1:>3} {om:>14} {fr:>11} {kind:>5} {num(m.modal_mass[j]):>16}"
         row += "".join(f" {_pct(pct[d][j]):>9}" for d in dirs)
         click.echo(row)
+    from microg.dynamics.modes import MODAL_MASS_NORMALISATION
+
+    click.echo(f"  modal mass: {MODAL_MASS_NORMALISATION}")
+    over = np.flatnonzero(m.modal_mass_exceeds_model) + 1
+    if over.size:
+        click.echo(
+            f"  note: modes {', '.join(map(str, over))} have a modal mass above the model's "
+            f"{structure.total_mass:.6g} kg: they barely move any point with a position (their "
+            "motion is on coordinates without one, such as dropped scalar points), so that "
+            "modal mass is not a physical mass"
+        )
     for note in m.notes:
         click.echo(f"  note: {note}")
     if uff_out is not None:

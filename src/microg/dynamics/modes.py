@@ -49,6 +49,11 @@ DEFAULT_N_MODES = defaults.N_MODES
 #: same size); a gravity-gradient coupling (~1e-7 of the mode) is far above it.
 EFFECTIVE_MASS_ZERO = 64.0
 _EPS = float(np.finfo(float).eps)
+#: what ``Modes.modal_mass`` is normalised to (the modes table and ``--json`` say it)
+MODAL_MASS_NORMALISATION = (
+    "shape scaled to a largest point motion of 1 m: max(|u|, L_c |theta|) over the named "
+    "points and the structure's samples, L_c the radius of gyration about the centre of mass"
+)
 
 
 @dataclass(frozen=True)
@@ -157,6 +162,21 @@ class Modes:
                 out[d] = np.asarray(self.effective_mass[d]) / total
         return out
 
+    @property
+    def modal_mass_exceeds_model(self) -> np.ndarray:
+        """(m,) modes whose modal mass exceeds the model's total mass.
+
+        Scaled to a largest point motion of 1 m, a shape's generalized mass is at most the
+        mass it moves, so at most the model's mass when every coordinate has a position.
+        Above it the shape barely moves any point with a position: its motion lies on
+        coordinates without one (an imported model's scalar points, dropped), and its modal
+        mass is not a physical mass.
+        """
+        total = float(getattr(self.structure, "total_mass", 0.0) or 0.0)
+        if total <= 0:
+            return np.zeros(self.n_modes, bool)
+        return np.asarray(self.modal_mass, float) > total * (1.0 + 1e-9)
+
     def subset(self, index: np.ndarray | slice) -> Modes:
         """The modes selected by ``index``."""
         assert self.unstable is not None and self.growth_rate is not None
@@ -178,16 +198,20 @@ class Modes:
         """The ``microg modes --json`` contract: method, notes and one object per mode.
 
         Per mode: ``omega`` (rad/s), ``freq_hz``, ``rigid``, ``unstable``,
-        ``growth_rate_rad_s``, ``elastic``, ``modal_mass`` (kg, see the class docstring),
+        ``growth_rate_rad_s``, ``elastic``, ``modal_mass`` (kg, see the class docstring and
+        ``modal_mass_normalised_to``), ``modal_mass_exceeds_model_mass``
+        (:attr:`modal_mass_exceeds_model`),
         ``effective_mass`` (kg or kg m^2 per direction) and ``effective_mass_fraction``
         (per direction, of ``r^T M r``).
         """
         assert self.unstable is not None and self.growth_rate is not None
         frac = self.effective_mass_fraction
         el = self.elastic
+        over = self.modal_mass_exceeds_model
         return {
             "method": self.method,
             "notes": list(self.notes),
+            "modal_mass_normalised_to": MODAL_MASS_NORMALISATION,
             "modes": [
                 {
                     "omega": float(self.omega[j]),
@@ -197,6 +221,7 @@ class Modes:
                     "growth_rate_rad_s": float(self.growth_rate[j]),
                     "elastic": bool(el[j]),
                     "modal_mass": float(self.modal_mass[j]),
+                    "modal_mass_exceeds_model_mass": bool(over[j]),
                     "effective_mass": {d: float(v[j]) for d, v in self.effective_mass.items()},
                     "effective_mass_fraction": {d: float(v[j]) for d, v in frac.items()},
                 }
