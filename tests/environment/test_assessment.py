@@ -213,8 +213,22 @@ def test_unresolved_exceedance_is_not_a_pass():
     # a tone well inside the resolved range, below its limit, still passes
     ok = 2e-6 * G0 * np.sqrt(2) * np.sin(2 * np.pi * 1.0 * TIME)
     assert assess(TIME, ok[None, :], transient=None).complies is True
-    # the 0.02 Hz bin is shared by the 0.0156, 0.0197 and 0.0248 Hz bands (df = 0.01 Hz)
-    assert 0.0197 in res.to_dict()["third_octave"]["unresolved_exceeding_hz"]
+    # the 0.02 Hz bin lies in the 0.0197 Hz band (0.0176-0.0223 Hz; df = 0.01 Hz) only
+    assert res.to_dict()["third_octave"]["unresolved_exceeding_hz"] == [0.0197]
+
+
+def test_unresolved_exceedances_are_one_warning_listing_the_bands():
+    # tones in four unresolved bands of a 20-s record: one warning for the kind, naming each
+    t = np.arange(2000) * 0.01
+    a = sum(50e-6 * G0 * np.sin(2 * np.pi * f * t) for f in (0.05, 0.1, 0.15, 0.2)) * np.ones(
+        (1, 1)
+    )
+    res = assess(t, a, transient=None)
+    over = res.to_dict()["third_octave"]["unresolved_exceeding_hz"]
+    assert len(over) >= 4
+    lines = [w for w in res.warnings if "not resolved" in w]
+    assert len(lines) == 1 and lines[0].startswith(f"{len(over)} bands are not resolved")
+    assert all(f"{c:.4g} Hz (" in lines[0] for c in over)
 
 
 def test_pims_steps_are_the_ssp_curve_near_the_upper_edge():
@@ -344,6 +358,7 @@ def test_to_dict_units_inf_and_json():
     plain = {
         "third_octave", "requirement", "requirement_source", "complies", "worst_band", "record",
         "integrated_accel_sliding", "integrated_accel_pims", "transient", "warnings",
+        "criteria",
     }  # fmt: skip
     for k in d:
         assert k in plain or k.endswith(units), k

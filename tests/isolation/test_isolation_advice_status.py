@@ -46,7 +46,7 @@ def test_not_needed_names_a_reported_only_exceedance():
     assert d["complies"] is True and adv.status == "not-needed" and not adv.needed
     rep = [c for c in d["criteria"] if c["status"] == "reported" and c["complies"] is False]
     assert [c["name"] for c in rep] == ["integrated-10ug-s-per-axis-10s"]
-    assert rep[0]["value"] == pytest.approx(20.0, rel=1e-9)  # 2 micro-g x 10 s
+    assert rep[0]["value_ug_s"] == pytest.approx(20.0, rel=1e-9)  # 2 micro-g x 10 s
     assert "integrated-10ug-s-per-axis-10s" in adv.note and "not in the verdict" in adv.note
 
 

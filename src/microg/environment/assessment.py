@@ -369,12 +369,17 @@ def assess(
             "called compliant; lengthen the record"
         )
     over = ~judged & np.any(rms_g > limit, axis=0)
-    for i in np.nonzero(over)[0]:
+    if np.any(over):  # one warning for the kind, listing its bands
+        listed = "; ".join(
+            f"{third.center_hz[i]:.4g} Hz ({rms_g[:, i].max():.3g} g > {limit[i]:.3g} g: "
+            f"{br.reasons[i]})"
+            for i in np.nonzero(over)[0]
+        )
         warnings.append(
-            f"band {third.center_hz[i]:.4g} Hz is not resolved ({br.reasons[i]}), and its band "
-            f"RMS estimate {rms_g[:, i].max():.3g} g exceeds its limit {limit[i]:.3g} g: "
-            "compliance cannot be shown, so the verdict is not a pass; lengthen the record to "
-            "judge the band"
+            f"{int(over.sum())} bands are not resolved and have a band RMS estimate above their "
+            f"limit, so compliance cannot be shown and the verdict is not a pass: {listed}; "
+            "lengthen "
+            "the record (or sample faster, for bands at Nyquist) to judge them"
         )
     if np.any(over):
         complies = False

@@ -75,18 +75,26 @@ class CriterionVerdict:
         )
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON-ready (an infinite margin is ``"inf"``, an undecided one None)."""
+        """JSON-ready criterion; keys carry the unit.
+
+        ``value_g``/``limit_g`` (peaks, band RMS) or ``value_ug_s``/``limit_ug_s`` (integrated
+        accelerations); an infinite margin is ``"inf"``, an undecided one None.
+        """
+        suffix = _JSON_SUFFIX[self.unit]
         return {
             "name": self.name,
             "status": self.status,
             "complies": self.complies,
             "margin": json_number(self.margin),
-            "value": json_number(self.value),
-            "limit": json_number(self.limit),
-            "unit": self.unit,
+            f"value{suffix}": json_number(self.value),
+            f"limit{suffix}": json_number(self.limit),
             "source": self.source,
             "why": self.why,
         }
+
+
+#: the JSON key suffix of each unit a criterion's value is in
+_JSON_SUFFIX = {"g": "_g", "micro-g s": "_ug_s"}
 
 
 def _margin(limit: float, value: float) -> float:
