@@ -297,14 +297,26 @@ def _history_on(ax: Any, ob: Observation) -> None:
 
 
 def _bands_on(ax: Any, ob: Observation) -> None:
-    """The 1/3-octave band RMS at a point against the limit's steps, micro-g."""
+    """The 1/3-octave band RMS at a point against the limit's steps, micro-g.
+
+    As the assess plot (``plotting.environment.plot_bands``): filled markers on the bands the
+    verdict judges, hollow on the bands the record does not resolve, the judged range shaded.
+    """
     to = ob.assessment.third_octave
+    res = np.asarray(to.resolved, bool)
     for i in live_axes(ob.response.acceleration):
-        ax.loglog(
-            to.center_hz, np.maximum(to.rms_g[i] * 1e6, 1e-30), "o-", ms=3, lw=0.8, label="xyz"[i]
-        )
+        y = np.maximum(to.rms_g[i] * 1e6, 1e-30)
+        (ln,) = ax.loglog(to.center_hz, y, "-", lw=0.8, label="xyz"[i])
+        c = ln.get_color()
+        ax.plot(to.center_hz[res], y[res], "o", ms=3, color=c, label="_judged")
+        ax.plot(to.center_hz[~res], y[~res], "o", ms=3, mfc="none", color=c, label="_unjudged")
     edges = np.r_[to.lower_hz, to.upper_hz[-1:]]
     ax.stairs(to.limit_g * 1e6, edges, color="k", lw=1.4, label="limit")
+    vr = to.verdict_range_hz
+    if vr is not None:
+        ax.axvspan(vr[0], vr[1], color="0.85", alpha=0.4, lw=0, label="judged bands")
+    if np.any(~res):
+        ax.plot([], [], "o", ms=3, mfc="none", color="0.3", label="not judged (hollow)")
     ax.set_xlabel("frequency [Hz]")
     ax.set_ylabel("band RMS [micro-g]")
     ax.grid(True, which="both", alpha=0.3)

@@ -206,13 +206,17 @@ def plot_integrated(
     title: str = "",
     ax: Axes | None = None,
 ) -> Figure:
-    """Each window's (or block's) integral of the acceleration (m/s) against its start, s."""
+    """Each window's (or block's) integral of the acceleration against its start, s.
+
+    In micro-g s (``m/s / G0 * 1e6``), the unit of the transient criteria and of the report's
+    tables: one unit per quantity.
+    """
     kind = "blocks" if hasattr(integ, "block_samples") else "sliding"
     fig, ax = _figure(ax, title or f"Integrated acceleration, {kind} {integ.window_s:g}-s windows")
     for name, row in zip(axes, integ.delta_v, strict=False):
-        ax.plot(*envelope(integ.t_start, row), label=name, lw=0.8)
+        ax.plot(*envelope(integ.t_start, np.asarray(row) / G0 * 1e6), label=name, lw=0.8)
     ax.set_xlabel("window start [s]")
-    ax.set_ylabel("integral of acceleration [m/s]")
+    ax.set_ylabel("integral of acceleration [micro-g s]")
     ax.grid(True, alpha=0.3)
     ax.legend()
     return fig
@@ -227,7 +231,7 @@ def plot_integrated_acceleration(
     title: str = "",
     ax: Axes | None = None,
 ) -> Figure:
-    """Integrated acceleration over sliding windows (m/s) of a record (times s, m/s^2)."""
+    """Integrated acceleration over sliding windows (micro-g s) of a record (times s, m/s^2)."""
     return plot_integrated(
         integrated_acceleration(timepts, accel, window_s), axes=axes, title=title, ax=ax
     )
