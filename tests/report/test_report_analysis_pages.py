@@ -1,0 +1,38 @@
+"""What the analyze report shows: no empty tables, no dangling headers, numbers kept whole."""
+
+from __future__ import annotations
+
+import re
+
+import pytest
+
+import microg
+from microg.report.analysis import report_files
+
+
+@pytest.fixture(scope="module")
+def sources_page() -> str:
+    r = microg.analyze("ioc", sources="example", observe=["lab"])
+    return report_files(r)["report.html"]
+
+
+def test_sources_report_has_no_empty_force_or_point_table(sources_page: str) -> None:
+    # the --sources run has no time-domain force and no time-domain observation: the page
+    # says so instead of tables with headers and no rows
+    assert '<th class="l">force</th>' not in sources_page
+    assert "No time-domain force in this run" in sources_page
+    assert "No time-domain response in this run" in sources_page
+    assert "-s interval margin" not in sources_page and "worst -s" not in sources_page
+    for table in re.findall(r"<table>(.*?)</table>", sources_page, flags=re.S):
+        assert "<td" in table  # every table has rows
+
+
+def test_numeric_cells_do_not_wrap(sources_page: str) -> None:
+    assert re.search(r"td:not\(\.l\)\s*\{\s*white-space:\s*nowrap;", sources_page)
+
+
+def test_time_domain_report_names_the_interval() -> None:
+    r = microg.analyze("ioc", duration=40.0, dt=0.02, observe=["lab"], isolation=False)
+    page = report_files(r)["report.html"]
+    iv = r.observations["lab"].interval["interval_s"]
+    assert f"worst {iv}-s interval margin" in page
