@@ -36,3 +36,18 @@ def test_time_domain_report_names_the_interval() -> None:
     page = report_files(r)["report.html"]
     iv = r.observations["lab"].interval["interval_s"]
     assert f"worst {iv}-s interval margin" in page
+
+
+def test_each_point_lists_its_verdict_per_criterion() -> None:
+    # a 20-s record: judged bands, undecided unresolved bands, reported-only criteria; the
+    # page's rows are the JSON's criteria, in order, and the isolation line names its status
+    r = microg.analyze("ioc", duration=20.0, dt=0.02, observe=["lab"])
+    page = report_files(r)["report.html"]
+    crit = r.to_dict()["observations"]["lab"]["criteria"]
+    i = page.index("<b>Verdict per criterion</b> at lab")
+    section = page[i : page.index("</table>", i)]
+    rows = re.findall(r"<tr><td class=\"l\">(.*?)</td>", section)
+    assert rows == [c["name"] for c in crit]
+    assert "undecided" in section and "reported only" in section
+    status = r.observations["lab"].isolation.status
+    assert f"<b>Isolation</b> ({status}):" in page
