@@ -90,6 +90,12 @@ def test_summary_and_out(tmp_path: Path, csv_file: Path, capsys) -> None:
     )
     assert rc == 0, err
     assert "vs ssp41000: complies" in out and "judged" in out
+    # one line per criterion, the same list as the JSON's (judged, reported only, undecided)
+    obs = json.loads((out_dir / "results.json").read_text())["observations"]
+    crit = next(iter(obs.values()))["criteria"]
+    i = out.index("  verdict per criterion:\n")
+    lines = out[i:].splitlines()[1 : 1 + len(crit)]
+    assert [ln.strip().split(":")[0] for ln in lines] == [c["name"] for c in crit]
     names = {p.name for p in out_dir.iterdir()}
     assert "results.json" in names
     assert {"sensor-third-octave.png", "sensor-percentiles.png", "sensor-spectrogram.png"} <= names

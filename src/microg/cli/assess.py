@@ -328,9 +328,8 @@ def _summary(result: dict[str, Any]) -> None:
             f"  integrated acceleration (PIMS, {pb.n_blocks} blocks of {pb.window_s:g} s): "
             f"max {num(worst)} micro-g s"
         )
-    if a.transient is not None:
-        tag = "" if a.transient.verified else " (unverified values: reported, not in the verdict)"
-        state = "met" if a.transient.complies else "exceeded"
-        click.echo(f"  transient criteria {a.transient.criteria}: {state}{tag}")
+    click.echo("  verdict per criterion:")
+    for c in a.criteria:
+        click.echo(f"    {c.line()}")
     for w in result["json"]["warnings"]:
         click.echo(f"  warning: {w}")
