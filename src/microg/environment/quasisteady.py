@@ -763,12 +763,13 @@ def quasi_steady(
         warnings.append("the model names no points: only the centre of mass is judged")
     if beta is None:
         fails = [n_ for n_ in judged if out_points[n_].complies is False]
+        ug = 1e6 / G0
         overall: bool | None = False if fails else None
         if fails:
             warnings.append(
                 "without drag input the verdict is a fail: at "
                 + ", ".join(
-                    f"{n_} (>= {out_points[n_].peak_lower_bound_mps2 / G0 * 1e6:.3g} micro-g)"
+                    f"{n_} (>= {(out_points[n_].peak_lower_bound_mps2 or 0.0) * ug:.3g} micro-g)"
                     for n_ in fails
                 )
                 + f" gravity gradient and rotation exceed {req.limit_g * 1e6:.3g} micro-g "
