@@ -264,3 +264,24 @@ def test_a_record_beyond_the_physical_limit_is_refused_with_its_value(tmp_path, 
     assert len(err.strip().splitlines()) == 1
     assert "beyond the physical limit" in err and "sample 1 of axis x" in err
     assert not out_dir.exists()
+
+
+def test_a_measured_tone_near_a_band_edge_keeps_its_whole_rms(tmp_path: Path, capsys) -> None:
+    # the measured path: 2.4 micro-g RMS at 0.11333 Hz (a bin of a 300-s record at 10 Hz) in
+    # the 0.1122-0.1413 Hz band (limit 2.25 micro-g); written with 17 digits, so the band RMS
+    # is the tone's to 1e-9 (the CSV's rounding) and the band fails
+    fs, n = 10.0, 3000
+    t = np.arange(n) / fs
+    x = 2.4e-6 * np.sqrt(2) * np.sin(2 * np.pi * (34 / 300) * t)
+    path = tmp_path / "tone.csv"
+    body = "\n".join(f"{ti:.10g},{v:.17g},0,0" for ti, v in zip(t, x, strict=True))
+    path.write_text("time [s], x [g], y [g], z [g]\n" + body + "\n")
+    rc, out, err = _run(capsys, ["assess", str(path), "--json"])
+    assert rc == 0, err
+    o = next(iter(json.loads(out)["observations"].values()))
+    to = o["third_octave"]
+    b = to["center_hz"].index(0.125)
+    assert to["rms_g_axis"]["x"][b] == pytest.approx(2.4e-6, rel=1e-9)
+    assert to["rms_g_axis"]["x"][b - 1] < 1e-6 * 2.4e-6
+    assert to["resolved"][b] and to["margin_axis"]["x"][b] < 1.0
+    assert o["complies"] is False
