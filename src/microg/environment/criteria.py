@@ -19,16 +19,13 @@ undecided (:func:`verdict_complies`).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
 from microg._json import json_number
 from microg.environment.bands import MIN_BINS, MIN_TIME_BANDWIDTH
 from microg.units import G0
-
-if TYPE_CHECKING:
-    from microg.environment.assessment import Assessment
 
 __all__ = ["STATUSES", "CriterionVerdict", "criterion_verdicts", "verdict_complies"]
 
@@ -102,13 +99,14 @@ def _margin(limit: float, value: float) -> float:
 
 
 def criterion_verdicts(
-    a: Assessment, extra: tuple[CriterionVerdict, ...] = ()
+    a: Any, extra: tuple[CriterionVerdict, ...] = ()
 ) -> tuple[CriterionVerdict, ...]:
     """Every criterion of an assessment, one verdict each (see the module docstring).
 
     Parameters
     ----------
-    a : the assessment
+    a : the :class:`~microg.environment.assessment.Assessment` (not imported here: the
+        assessment imports this module)
     extra : further reported-only criteria to list after the assessment's own
     """
     to = a.third_octave
@@ -210,7 +208,7 @@ def _needs_faster_sampling(reasons: tuple[str, ...], i: int) -> bool:
     return "Nyquist" in r or "cutoff" in r
 
 
-def _record_needed(a: Assessment, i: int) -> float:
+def _record_needed(a: Any, i: int) -> float:
     """Shortest record that resolves band ``i`` (both rules of microg.environment.bands), s."""
     to = a.third_octave
     width = float(to.upper_hz[i] - to.lower_hz[i])
