@@ -10,31 +10,32 @@ from pathlib import Path
 import pytest
 
 from microg.cli import main
-from microg.report.environment import band_verdict
+from microg.report.environment import criterion_verdict
 
 ROOT = Path(__file__).resolve().parents[2]
 
 
 @pytest.mark.parametrize(
-    ("obs", "verdict", "css"),
+    ("criterion", "verdict", "css"),
     [
-        ({"complies": True, "worst_band": {"margin": 5.6}}, "complies", "pass"),
-        ({"complies": False, "worst_band": {"margin": 0.4}}, "fails (margin 0.4)", "fail"),
+        ({"status": "judged", "complies": True, "margin": 5.6}, "complies (margin 5.6)", "pass"),
+        ({"status": "judged", "complies": False, "margin": 0.4}, "fails (margin 0.4)", "fail"),
         (
-            {
-                "complies": False,
-                "worst_band": {"margin": 1.47},
-                "third_octave": {"unresolved_exceeding_hz": [0.1]},
-            },
-            "not shown: bands the record cannot resolve exceed their limits",
-            "undecided",
+            {"status": "reported", "complies": False, "margin": 0.33},
+            "reported only: exceeds its limit (margin 0.33)",
+            "warn",
         ),
-        ({"complies": False, "worst_band": None}, "not shown", "undecided"),
+        (
+            {"status": "reported", "complies": True, "margin": "inf"},
+            "reported only: within its limit",
+            "",
+        ),
+        ({"status": "undecided", "complies": None, "margin": None}, "undecided", "undecided"),
     ],
 )
-def test_each_band_verdict_follows_its_fields(obs, verdict, css):
-    # never "complies" unless the result says so; "fails" only on a judged margin below 1
-    assert band_verdict(obs) == (verdict, css)
+def test_each_criterion_verdict_follows_its_fields(criterion, verdict, css):
+    # "complies" or "fails" only for a judged criterion, by its own complies field
+    assert criterion_verdict(criterion) == (verdict, css)
 
 
 def test_assess_writes_a_report_with_every_band(tmp_path: Path) -> None:
@@ -48,7 +49,11 @@ def test_assess_writes_a_report_with_every_band(tmp_path: Path) -> None:
     assert len(rows) == len(to["center_hz"])
     # a band the record does not resolve is marked on its row, whatever its value
     assert [r == "unjudged" for r in rows] == [not r for r in to["resolved"]]
-    assert key in html and band_verdict(obs)[0] in html
+    assert key in html
+    for c in obs["criteria"]:
+        row = html.split(f'<td class="l">{c["name"]}</td>', 1)[1].split("</tr>", 1)[0]
+        assert criterion_verdict(c)[0] in row and c["why"] in row
+    assert ("Verdict: complies" in html) == obs["complies"]
     assert len(re.findall(r'<img [^>]*src="data:image/png;base64,', html)) == len(
         list(out.glob("*.png"))
     )

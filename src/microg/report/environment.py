@@ -1,8 +1,9 @@
 """HTML of ``microg assess`` and ``microg quasi-steady`` (reads their JSON results).
 
 Each page is one self-contained file (figures embedded as data URIs) whose verdict lines follow
-from the fields beside them: a band verdict is "complies" only where the result says so, "fails"
-where a judged band's margin is below 1, and otherwise "not shown" with the reason.
+from the fields beside them: one row per criterion of the result's ``criteria`` (judged,
+reported only, or undecided, as :mod:`microg.environment.criteria` decides), with its margin,
+value, limit, why and source.
 """
 
 from __future__ import annotations
@@ -12,38 +13,29 @@ from typing import Any
 
 from microg._io import to_jsonable
 
-__all__ = ["band_verdict", "render_assessment", "render_quasi_steady"]
+__all__ = ["criterion_verdict", "render_assessment", "render_quasi_steady"]
 
 
-def band_verdict(obs: dict[str, Any]) -> tuple[str, str]:
-    """(verdict text, CSS class) of one observation's band criterion, from its own fields.
+def criterion_verdict(c: dict[str, Any]) -> tuple[str, str]:
+    """(verdict text, CSS class) of one criterion of the JSON ``criteria`` list, from its fields.
+
+    The words are :meth:`microg.environment.criteria.CriterionVerdict.line`'s: ``judged`` is
+    "complies" or "fails", ``reported`` adds "reported only" (its limit does not enter the
+    verdict), ``undecided`` says so.
 
     Parameters
     ----------
-    obs : an observation of the assess contract (``complies``, ``worst_band``,
-        ``third_octave.unresolved_exceeding_hz``)
+    c : one entry of an observation's ``criteria`` (``status``, ``complies``, ``margin``)
     """
-    worst = obs.get("worst_band") or {}
-    margin = worst.get("margin")
-    if obs.get("complies") is True:
-        return "complies", "pass"
-    if isinstance(margin, int | float) and margin < 1.0:
-        return f"fails (margin {margin:.3g})", "fail"
-    if obs.get("third_octave", {}).get("unresolved_exceeding_hz"):
-        return "not shown: bands the record cannot resolve exceed their limits", "undecided"
-    return "not shown", "undecided"
-
-
-def _transient_verdict(tr: dict[str, Any] | None) -> tuple[str, str]:
-    if not tr:
-        return "", ""
-    if tr.get("complies") is True:
-        return "complies", "pass"
-    if tr.get("complies") is False and tr.get("verified"):
-        return "fails", "fail"
-    if tr.get("complies") is False:
-        return "exceeded (an unverified criterion: reported, not judged)", "warn"
-    return "undecided", "undecided"
+    if c.get("status") == "undecided" or c.get("complies") is None:
+        return "undecided", "undecided"
+    margin = c.get("margin")
+    m = f" (margin {margin:.3g})" if isinstance(margin, int | float) else ""
+    if c.get("status") == "judged":
+        return ("complies" + m, "pass") if c["complies"] else ("fails" + m, "fail")
+    if c["complies"]:
+        return "reported only: within its limit" + m, ""
+    return "reported only: exceeds its limit" + m, "warn"
 
 
 def render_assessment(payload: dict[str, Any], figs: dict[str, dict[str, bytes]]) -> str:
@@ -60,16 +52,12 @@ def render_assessment(payload: dict[str, Any], figs: dict[str, dict[str, bytes]]
     d = to_jsonable(payload)
     sensors = []
     for key, obs in d["observations"].items():
-        verdict, css = band_verdict(obs)
-        tv, tc = _transient_verdict(obs.get("transient"))
+        rows = [{**c, "verdict": criterion_verdict(c)} for c in obs.get("criteria", [])]
         sensors.append(
             {
                 "name": key,
                 "data": obs,
-                "band_verdict": verdict,
-                "band_class": css,
-                "transient_verdict": tv,
-                "transient_class": tc,
+                "criteria": rows,
                 "figs": [png_data_uri(b) for b in figs.get(key, {}).values()],
             }
         )
