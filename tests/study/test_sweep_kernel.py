@@ -43,6 +43,7 @@ variant = [
 duration = "60 s"
 dt = "0.1 s"
 max_freq = "2 Hz"
+peaks = "exact"
 [[point]]
 name = "keel-mid"
 on = "keel"
@@ -158,6 +159,68 @@ def test_the_pruned_exact_peak_equals_the_whole_record_search(result) -> None:
     np.testing.assert_allclose(got["peak_axis"], ref_ax, rtol=2e-10, atol=1e-12 * ref.max())
 
 
+def test_the_default_rule_changes_no_verdict_and_certifies_only_near_a_limit(result, data):
+    """``peaks = "verdict"`` (the default): every value but the peaks is the exact rule's, bit
+    for bit; the peaks are the sampled record's (at most the certified exact peak) unless a
+    verdict's limit lies between a sampled peak and its bound."""
+    text = TEXT.replace('peaks = "exact"\n', "")
+    fast = sweep(loads_study(text, filename="study.toml"))
+    got = fast.dataset.load()
+    for v in ("rms_accel_g", "rms_accel_g_axis", "band_rms_g", "margin", "complies", "computed"):
+        assert np.array_equal(got[v].values, data[v].values, equal_nan=True), v
+    # no limit of the iss set depends on the peak: no case is searched
+    assert not got.peak_certified.values.any() and fast.summary().peaks_certified == 0
+    assert int(data.peak_certified.sum()) == result.summary().peaks_certified > 0
+    # a sampled maximum is at most the supremum it samples (the exact one, found to 1e-10)
+    assert np.all(got.peak_accel_g.values <= data.peak_accel_g.values * (1 + 1e-15))
+    assert np.all(got.peak_accel_g_axis.values <= data.peak_accel_g_axis.values * (1 + 1e-15))
+
+
+def test_a_limit_between_the_sampled_peak_and_its_bound_is_certified(result) -> None:
+    """The search runs exactly for the cases whose verdict the exact peak may change, and
+    finds there the peaks of the search over every case (both certified to 1e-10)."""
+    from microg.study.kernel import (
+        BlockWork,
+        _coefficients,
+        _exact_peaks,
+        kernel_plan,
+        modal_group,
+        solve_basis,
+    )
+    from microg.study.run import _solve_args
+
+    s = result.study
+    plan = kernel_plan(s)
+    model, kw = _solve_args(s, 0, 0)
+    basis = solve_basis(model, **kw)
+    blk = s.block(0)
+    work = BlockWork(blk.id, blk.index, blk.at, blk.observe, s.block_mask(blk.index, blk.at,
+                                                                        blk.observe))  # fmt: skip
+    group = modal_group(basis, plan, 0, 0, 0)
+    force = plan.forces[0]
+    c, _ = _coefficients(basis, plan, group, work, force)
+    every = _exact_peaks(c, group, force, plan.timepts)
+    none = _exact_peaks(c, group, force, plan.timepts, ([], []))
+    assert every["certified"].all() and not none["certified"].any()
+    sampled, exact = none["peak"], every["peak"]
+    assert np.all(sampled <= exact * (1 + 1e-15))
+    # a limit just above case k's exact peak: the sampled value is below it, the bound above
+    k = int(np.argmax(exact / sampled))
+    assert exact[k] > sampled[k] * (1 + 1e-6)  # the sampling misses this peak's top
+    lim = exact[k] * (1 + 1e-8)
+    got = _exact_peaks(c, group, force, plan.timepts, ([lim], []))
+    assert got["certified"][k]
+    # searched: only cases whose sampled peak is at most the limit; and every case whose
+    # exact peak lies above it (its bound does too)
+    assert np.all(sampled[got["certified"]] <= lim * (1 + 1e-9))
+    assert np.all(got["certified"][(sampled <= lim) & (exact > lim)])
+    np.testing.assert_allclose(got["peak"][k], exact[k], rtol=2e-10)  # both to 1e-10
+    # a limit no case's bound reaches, and one below every sampled peak: nothing to search
+    far = _exact_peaks(c, group, force, plan.timepts, ([10 * exact.max()], [0.5 * sampled.min()]))
+    assert not far["certified"].any()
+    assert np.array_equal(far["peak"], sampled)
+
+
 def test_the_rigid_modes_share_one_row(result) -> None:
     from microg.study.kernel import kernel_plan, modal_group, solve_basis
     from microg.study.run import _solve_args
@@ -193,6 +256,7 @@ damping = [0.005, 0.02]
 duration = "40 s"
 dt = "0.1 s"
 max_freq = "2 Hz"
+peaks = "exact"
 """
 
 
@@ -264,6 +328,7 @@ damping = [0.01]
 [record]
 duration = "60 s"
 dt = "0.005 s"
+peaks = "exact"
 """
     r = sweep(loads_study(text, filename="modal.toml"))
     ds = r.dataset.load()

@@ -122,12 +122,18 @@ class DirectionItem:
 
 @dataclass(frozen=True)
 class Record:
-    """The output record and the requirement, SI."""
+    """The output record and the requirement, SI.
+
+    ``peaks``: ``"verdict"`` searches the exact (certified) peak of a case only where the
+    verdict may depend on it (the sampled peak and its certified bound straddle a peak limit);
+    ``"exact"`` searches it for every case without an isolator.
+    """
 
     duration_s: float
     dt_s: float
     max_freq_hz: float
     requirement: str
+    peaks: str = "verdict"
 
     @property
     def timepts(self) -> np.ndarray:

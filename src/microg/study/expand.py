@@ -272,6 +272,7 @@ class _Builder:
             dt_s=self.q(r.dt, "time", "record.dt"),
             max_freq_hz=self.q(r.max_freq, "frequency", "record.max_freq"),
             requirement=r.requirement,
+            peaks=r.peaks,
         )
         try:
             requirement(r.requirement)

@@ -51,7 +51,9 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from microg.dynamics.forces import ForceHistory
-from microg.dynamics.response import modal_pwl_response, peak_response
+from microg.dynamics.peaks import certified_peaks
+from microg.dynamics.pwl import ModalState, check_inputs, prepare
+from microg.dynamics.response import combined_modal_force, modal_pwl_response
 from microg.environment.metrics import Spectrum, acceleration_psd, band_rms
 from microg.environment.requirements import Requirement
 from microg.environment.requirements import requirement as requirement_by_name
@@ -74,6 +76,7 @@ __all__ = [
     "run_blocks",
     "catalogue_block",
     "kernel_plan",
+    "peak_limits",
 ]
 
 #: the transient criteria set the analysis' assessment judges (assess's default)
@@ -89,6 +92,8 @@ _MERGE = 200
 _SPAN = 2000
 #: relative tolerance of the exact peaks: well inside the analysis' own certified 1e-9
 PEAK_RTOL = 1e-10
+#: refinement rounds of the exact-peak search (peak_response's default)
+_PEAK_ROUNDS = 30
 
 
 @dataclass(frozen=True)
@@ -154,6 +159,8 @@ class KernelPlan:
     mounts : isolator of each value of the isolator axis (None: no isolator)
     directions : (n_dir, 3) unit vectors of the direction axis
     catalogues : the source catalogue of each force value (None: a time history)
+    peaks : ``"verdict"``: the exact peak is searched only for the cases whose verdict it
+        may change (:func:`peak_limits`); ``"exact"``: for every case without an isolator
     """
 
     timepts: np.ndarray = field(repr=False)
@@ -163,6 +170,7 @@ class KernelPlan:
     mounts: tuple[IsolatorModel | None, ...]
     directions: np.ndarray
     catalogues: tuple[Any, ...] = ()
+    peaks: str = "verdict"
 
 
 @dataclass(frozen=True)
@@ -197,6 +205,9 @@ class ModalGroup:
     limit_g, resolved : (nb,) the requirement's limits (g) and the bands the record resolves
     center_hz, lower_hz, upper_hz : (nb,) the bands kept (lower edge below Nyquist)
     dv : window -> (m', nw) sliding integrals of ``h`` (only for verified integral criteria)
+    state : the modal state of the rows under the unit modal force at every force segment's
+        start (:func:`~microg.dynamics.pwl.prepare`), shared by every exact-peak search of
+        the group; None behind an isolator
     """
 
     rows: np.ndarray = field(repr=False)
@@ -214,6 +225,7 @@ class ModalGroup:
     lower_hz: np.ndarray
     upper_hz: np.ndarray
     dv: dict[float, np.ndarray] = field(default_factory=dict, repr=False)
+    state: ModalState | None = field(default=None, repr=False)
 
 
 @dataclass(frozen=True)
@@ -454,11 +466,18 @@ def modal_group(
             dv[float(w)] = integrated_acceleration(t, h, w).delta_v
     # mean square of c . h over the record: |r c|^2 / nt with h^T = q r (no squared cancellation)
     gram_r = np.asarray(np.linalg.qr(h.T, mode="r"))
+    omega_r, zeta_r = np.asarray(basis.omega[first], float), np.asarray(zeta[first], float)
+    state = None
+    if mount is None:  # the exact-peak search's preparation, as peak_response makes it
+        ones = np.ones(omega_r.size)
+        tb, pf = combined_modal_force(np.eye(omega_r.size), [(f, ones)])
+        om, ze, tb, pf, _ = check_inputs(omega_r, zeta_r, tb, pf, t[:1])
+        state = prepare(om, ze, tb, pf)
     return ModalGroup(
         rows=rows,
         h=h,
-        omega=np.asarray(basis.omega[first], float),
-        zeta=np.asarray(zeta[first], float),
+        omega=omega_r,
+        zeta=zeta_r,
         gram_r=gram_r,
         exact_peaks=mount is None,
         x=x,
@@ -470,6 +489,7 @@ def modal_group(
         lower_hz=np.asarray(ref.bands.lower_hz, float),
         upper_hz=np.asarray(ref.bands.upper_hz, float),
         dv=dv,
+        state=state,
     )
 
 
@@ -654,34 +674,115 @@ def _candidates(
     return [np.unique(np.concatenate(x)) if x else np.zeros(0, int) for x in out]
 
 
+def _peak_upper(
+    c: np.ndarray,
+    t: np.ndarray,
+    bounds: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
+    sampled: dict[str, np.ndarray],
+    h: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Certified upper bounds of the exact peaks, magnitude (n,) and per axis (n, 3), m/s^2.
+
+    The rule of :func:`_candidates` over the whole record at once: no interval inside a force
+    segment exceeds the sampled maximum by more than the case's largest ``M2 dt^2 / 8``, and
+    each part of an interval holding a breakpoint stays within ``M1`` times its length of its
+    end sample.
+    """
+    b0, b1, b2, starts = bounds
+    nt = t.size
+    ac = np.abs(c)
+    B0, B1, B2 = ac @ b0, ac @ b1, ac @ b2  # (n, 3, K)
+    q = float(t[1] - t[0]) ** 2 / 8.0 if nt > 1 else 0.0
+    up_f = sampled["peak"] ** 2 + 2.0 * np.sum(B1 * B1 + B0 * B2, axis=1).max(axis=1) * q
+    up_a = sampled["peak_axis"] + B2.max(axis=2) * q
+    brk = np.searchsorted(t, starts, side="left") - 1
+    ok = (brk >= 0) & (brk < nt - 1)
+    brk, bt = brk[ok], starts[ok]
+    if brk.size:
+        seg_before = np.searchsorted(starts, bt, side="left") - 1
+        seg_after = np.searchsorted(starts, bt, side="right") - 1
+        left_len, right_len = bt - t[brk], t[brk + 1] - bt
+        sb, pre = np.maximum(seg_before, 0), seg_before >= 0
+        dF = 2.0 * np.sum(B0 * B1, axis=1)
+        n = c.shape[0]
+        a = (c.reshape(3 * n, -1) @ h[:, np.r_[brk, brk + 1]]).reshape(n, 3, -1)
+        al, ar = a[:, :, : brk.size], a[:, :, brk.size :]
+        ufl = np.where(pre, np.sum(al * al, axis=1) + dF[:, sb] * left_len, 0.0)
+        ufr = np.sum(ar * ar, axis=1) + dF[:, seg_after] * right_len
+        ual = np.where(pre, np.abs(al) + B1[:, :, sb] * left_len, 0.0)
+        uar = np.abs(ar) + B1[:, :, seg_after] * right_len
+        up_f = np.maximum(up_f, np.maximum(ufl, ufr).max(axis=1))
+        up_a = np.maximum(up_a, np.maximum(ual, uar).max(axis=2))
+    return np.sqrt(up_f), up_a
+
+
+def _straddles(value: np.ndarray, upper: np.ndarray, limits: Sequence[float]) -> np.ndarray:
+    """Cases whose exact peak, known to lie in ``[value, upper]``, may fall on either side of
+    a limit (widened by 1e-9 relative: the g conversion's rounding cannot flip a verdict)."""
+    need = np.zeros(value.shape, bool)
+    for lim in limits:
+        need |= (value * (1.0 - 1e-9) <= lim) & (lim < upper * (1.0 + 1e-9))
+    return need
+
+
 def _exact_peaks(
-    c: np.ndarray, group: ModalGroup, force: ForceHistory, t: np.ndarray
+    c: np.ndarray,
+    group: ModalGroup,
+    force: ForceHistory,
+    t: np.ndarray,
+    limits: tuple[Sequence[float], Sequence[float]] | None = None,
 ) -> dict[str, np.ndarray]:
     """Certified exact peaks (magnitude and per axis) of the records ``c @ h``, m/s^2.
 
     The sampled maxima first (:func:`_time_stats`); then
-    :func:`~microg.dynamics.response.peak_response` (the analysis' exact peak) on the windows
+    :func:`~microg.dynamics.peaks.certified_peaks` (the search of
+    :func:`~microg.dynamics.response.peak_response`, the analysis' exact peak) on the windows
     of consecutive candidate intervals (:func:`_candidates`), in the rows' coordinates
     (``phi = I``, the unit modal force on every row, each case a "point" whose translation map
-    is its coefficients).  Outside the windows no value can exceed the sampled maximum, so
-    the largest value found is the certified supremum over the record (to
-    :data:`PEAK_RTOL`).  Cases sharing a window are refined in one call.
+    is its coefficients), with the group's prepared modal state and the sampled values of the
+    records.  Outside the windows no value can exceed the sampled maximum, so the largest value
+    found is the certified supremum over the record (to :data:`PEAK_RTOL`).  Cases sharing a
+    window are refined in one call.
+
+    ``limits`` (m/s^2: the magnitude's and the largest axis value's limits of the verdict)
+    restricts the search to the cases whose sampled peak and certified upper bound
+    (:func:`_peak_upper`) straddle one of them; the others keep their sampled peaks, which
+    decide the verdict as the exact ones would.  ``certified`` (n,) marks the cases searched.
     """
     sampled = _time_stats(c, group.h)
     peak = sampled["peak"].copy()
     peak_ax = sampled["peak_axis"].copy()
-    cands = _candidates(c, group.h, t, _segment_bounds(group, force, t), sampled)
+    n = c.shape[0]
+    if limits is None:
+        todo = np.arange(n)
+    else:
+        todo = np.zeros(0, int)
+        if any(len(x) for x in limits):
+            bounds = _segment_bounds(group, force, t)
+            up, up_ax = _peak_upper(c, t, bounds, sampled, group.h)
+            need = _straddles(peak, up, limits[0]) | _straddles(
+                peak_ax.max(axis=1), up_ax.max(axis=1), limits[1]
+            )
+            todo = np.flatnonzero(need)
+    certified = np.zeros(n, bool)
+    certified[todo] = True
+    if todo.size == 0:
+        return {"peak": peak, "peak_axis": peak_ax, "certified": certified}
+    sub = c if todo.size == n else c[todo]
+    sub_sampled = {k: v[todo] for k, v in sampled.items()}
+    cands = _candidates(sub, group.h, t, _segment_bounds(group, force, t), sub_sampled)
     # windows: each case's candidate intervals, runs closer than _MERGE samples joined
     wins: list[tuple[int, int, int]] = []  # (first sample, last sample, case)
-    for case, iv in enumerate(cands):
+    for j, iv in enumerate(cands):
         if iv.size == 0:
             continue
+        case = int(todo[j])
         cut = np.flatnonzero(np.diff(iv) > _MERGE)
         for i0, i1 in zip(np.r_[iv[0], iv[cut + 1]], np.r_[iv[cut], iv[-1]], strict=True):
             wins.append((int(i0), int(i1) + 1, case))
     wins.sort()
-    m = c.shape[2]
-    eye, ones = np.eye(m), np.ones(m)
+    st = group.state
+    assert st is not None
     k = 0
     while k < len(wins):
         # a batch: consecutive windows whose hull stays short, at most _PEAK_CELLS of them
@@ -693,14 +794,17 @@ def _exact_peaks(
             j += 1
         batch = wins[k:j]
         k = j
-        maps = {str(i): c[case] for i, (_, _, case) in enumerate(batch)}
-        res = peak_response(group.omega, group.zeta, eye, maps, [(force, ones)], t[lo : hi + 1],
-                            rtol=PEAK_RTOL)  # fmt: skip
+        names = [str(i) for i in range(len(batch))]
+        proj = c[[case for _, _, case in batch]].reshape(3 * len(batch), -1)
+        # the sampled values of the records: their rows of h at the window's times
+        vals = proj @ group.h[:, lo : hi + 1]
+        res = certified_peaks(st, names, proj, t[lo : hi + 1], rtol=PEAK_RTOL,
+                              max_rounds=_PEAK_ROUNDS, grid_vals=vals)  # fmt: skip
         for i, (_, _, case) in enumerate(batch):
             r = res[str(i)]
             peak[case] = max(peak[case], r.peak_accel_mps2)
             peak_ax[case] = np.maximum(peak_ax[case], r.peak_accel_mps2_axis)
-    return {"peak": peak, "peak_axis": peak_ax}
+    return {"peak": peak, "peak_axis": peak_ax, "certified": certified}
 
 
 def _rms(c: np.ndarray, gram_r: np.ndarray, nt: int) -> dict[str, np.ndarray]:
@@ -772,6 +876,20 @@ def _verdict(
     return complies & transient_ok, worst
 
 
+def peak_limits(req: Requirement) -> tuple[list[float], list[float]]:
+    """The peak limits the verdict compares with, m/s^2: (magnitude's, largest axis value's).
+
+    The requirement's peak limit, and the verified transient criteria of
+    :data:`TRANSIENT_SET` on the peak (not the integral ones).
+    """
+    mag: list[float] = [] if req.peak_limit_g is None else [float(req.peak_limit_g) * G0]
+    axis: list[float] = []
+    for cr in transient_criteria(TRANSIENT_SET).criteria:
+        if cr.verified and not cr.is_integral:
+            (axis if cr.quantity.endswith("_axis") else mag).append(float(cr.limit))
+    return mag, axis
+
+
 def compute_block(
     basis: Basis, plan: KernelPlan, group: ModalGroup, work: BlockWork
 ) -> BlockResult:
@@ -788,9 +906,11 @@ def compute_block(
     assert force is not None
     c, cells = _coefficients(basis, plan, group, work, force)
     if group.exact_peaks:
-        stats = _exact_peaks(c, group, force, plan.timepts)
+        limits = None if plan.peaks == "exact" else peak_limits(plan.requirement)
+        stats = _exact_peaks(c, group, force, plan.timepts, limits)
     else:
         stats = _time_stats(c, group.h)
+        stats["certified"] = np.zeros(c.shape[0], bool)
     stats.update(_rms(c, group.gram_r, plan.timepts.size))
     rms_g = _band_rms(c, group, plan.requirement) / G0
     peak_g = stats["peak"] / G0
@@ -827,6 +947,7 @@ def compute_block(
         "band_rms_g": scatter(rms_g, np.nan, (3, nb)),
         "margin": scatter(margin, np.nan),
         "complies": scatter(complies, False),
+        "peak_certified": scatter(stats["certified"], False),
         "computed": scatter(np.ones(c.shape[0], bool), False),
     }
     return BlockResult(work.id, values)
@@ -859,6 +980,7 @@ def catalogue_block(basis: Basis, plan: KernelPlan, work: BlockWork) -> BlockRes
         "band_rms_g": spread(res["rms_g"], np.nan, (3, nb)),
         "margin": spread(res["margin"], np.nan),
         "complies": spread(res["complies"], False),
+        "peak_certified": np.zeros(shape, bool),
         "computed": m.copy(),
     }
     return BlockResult(work.id, values)
@@ -894,7 +1016,7 @@ def run_blocks(
 
 
 def kernel_plan(study: Any) -> KernelPlan:
-    """The KernelPlan of a :class:`~microg.study.cases.Study`."""
+    """The KernelPlan of a :class:`~microg.study.cases.Study` (its record's ``peaks`` rule)."""
     return KernelPlan(
         timepts=study.record.timepts,
         requirement=requirement_by_name(study.record.requirement),
@@ -903,4 +1025,5 @@ def kernel_plan(study: Any) -> KernelPlan:
         mounts=tuple(i.mount for i in study.isolators),
         directions=np.array([d.vector for d in study.directions], float),
         catalogues=tuple(f.catalogue for f in study.forces),
+        peaks=study.record.peaks,
     )

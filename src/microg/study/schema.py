@@ -9,7 +9,7 @@ Defaults are the analysis' (:data:`microg.analysis.DEFAULTS`); see ``docs/scale.
 from __future__ import annotations
 
 import math
-from typing import Annotated, Any
+from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, PlainValidator, StrictBool, StrictStr
 
@@ -145,6 +145,7 @@ class RecordIn(_In):
     dt: _Q = DEFAULTS["dt_s"]
     max_freq: _Q = DEFAULTS["max_freq_hz"]
     requirement: StrictStr = DEFAULTS["requirement"]
+    peaks: Literal["verdict", "exact"] = "verdict"
 
 
 def _one_or_list(item: Any) -> Any:

@@ -7,8 +7,10 @@ as one labelled Dataset):
   (x, y, z) and ``band`` (the requirement's 1/3-octave bands below Nyquist, by centre, Hz);
 * variables ``peak_accel_g``, ``rms_accel_g`` (magnitude), ``peak_accel_g_axis``,
   ``rms_accel_g_axis`` (per axis), ``band_rms_g`` (per axis and band), ``margin`` (the worst
-  ``limit / band RMS`` over the judged bands and axes), ``complies`` and ``computed`` (the case
-  is in the plan and its block is written); band coordinates ``band_lower_hz``,
+  ``limit / band RMS`` over the judged bands and axes), ``complies``, ``peak_certified`` (the
+  peaks are the certified exact maxima, searched where the verdict may depend on them or for
+  every case with ``[record] peaks = "exact"``; else the sampled record's) and ``computed``
+  (the case is in the plan and its block is written); band coordinates ``band_lower_hz``,
   ``band_upper_hz``, ``limit_g`` and ``judged`` (the bands the record resolves);
 * one chunk per variable and block (:meth:`~microg.study.cases.Study.block`): a block's values
   are written whole, by one writer (the process that runs the sweep), ``computed`` last;
@@ -47,6 +49,8 @@ VARIABLES: dict[str, tuple[tuple[str, ...], str, str, str]] = {
     "band_rms_g": (("axis", "band"), "float64", "g", "1/3-octave band RMS per axis"),
     "margin": ((), "float64", "1", "worst limit / band RMS over the judged bands and axes"),
     "complies": ((), "bool", "", "the band verdict (and verified transient criteria)"),
+    "peak_certified": ((), "bool", "", "the peaks are the certified exact maxima (else the "
+                       "sampled record's)"),
     "computed": ((), "bool", "", "the case is in the plan and has been computed"),
 }
 

@@ -3,7 +3,8 @@
 :func:`summarize` reads the store once, block by block (memory bounded by one block,
 whatever the size of the study), and keeps:
 
-* the number of cases computed and the fraction that comply;
+* the number of cases computed and the fraction that comply, and how many of them needed the
+  exact (certified) peak search;
 * the worst cases per observed point (smallest margin; a case whose record resolves no
   band, margin NaN, counts as worst: it cannot be shown to comply);
 * the worst margin over two chosen axes (the minimum over every other axis): the heat map;
@@ -81,6 +82,8 @@ class Summary:
     ----------
     cases : cases computed; planned : cases of the plan
     complying : cases that comply; complying_fraction : complying / cases (None: no case)
+    peaks_certified : cases whose peaks are the certified exact maxima (the others report
+        the sampled record's: the verdict does not depend on the difference)
     worst : per observed point, its worst cases (dicts: case labels, margin, peak, ...)
     heatmap_dims : the two axes of the heat map; heatmap_labels : their labels
     heatmap : (n1, n2) the worst margin over every other axis (NaN: nothing computed)
@@ -109,6 +112,7 @@ class Summary:
     out: str | None = None
     study: dict[str, Any] = field(default_factory=dict, repr=False)
     worst_bands: dict[str, dict[str, Any]] = field(default_factory=dict, repr=False)
+    peaks_certified: int = 0
 
     def worst_list(self) -> list[dict[str, Any]]:
         """The worst case of every observed point, worst first."""
@@ -123,6 +127,7 @@ class Summary:
             "worst": self.worst_list(),
             "planned": self.planned,
             "complying": self.complying,
+            "peaks_certified": self.peaks_certified,
             "worst_per_point": self.worst,
             "heatmap": {
                 "dims": list(self.heatmap_dims),
@@ -163,6 +168,7 @@ class Summary:
                 "cases": int(self.cases),
                 "planned": int(self.planned),
                 "complying": int(self.complying),
+                "peaks_certified": int(self.peaks_certified),
                 "complying_fraction": float("nan")
                 if self.complying_fraction is None
                 else float(self.complying_fraction),
@@ -238,8 +244,8 @@ def summarize(
     n_comp = {d: np.zeros(shape[d], np.int64) for d in CASE_DIMS}
     n_ok = {d: np.zeros(shape[d], np.int64) for d in CASE_DIMS}
     best: list[list[tuple[float, float, tuple[int, ...]]]] = [[] for _ in study.observe]
-    total = ok_total = 0
-    names = ("margin", "peak_accel_g", "complies", "computed")
+    total = ok_total = certified = 0
+    names = ("margin", "peak_accel_g", "complies", "computed", "peak_certified")
     for blk in study.blocks():
         v = result.store.read(blk, names)
         comp = v["computed"]
@@ -254,6 +260,7 @@ def summarize(
         margin, peak, comp8, ok8 = full
         ok8 = ok8 & comp8
         total += int(comp8.sum())
+        certified += int((v["peak_certified"] & comp).sum())
         ok_total += int(ok8.sum())
         for k, d in enumerate(CASE_DIMS):
             other = tuple(j for j in range(8) if j != k)
@@ -288,18 +295,17 @@ def summarize(
         del margin, peak
     worst: dict[str, list[dict[str, Any]]] = {}
     bands: dict[str, dict[str, Any]] = {}
-    ds = result.dataset if any(best) else None
-    for o, rows in enumerate(best):
-        worst[study.observe[o]] = [_case_row(result, ds, case) for _, _, case in rows]
-        if rows:
-            assert ds is not None
-            point = ds.isel(dict(zip(CASE_DIMS, rows[0][2], strict=True)))
+    rows = _case_values(result, sorted({case for b in best for _, _, case in b}))
+    for o, kept in enumerate(best):
+        worst[study.observe[o]] = [_case_row(result, rows, case) for _, _, case in kept]
+        if kept:
+            first = rows["cases"][kept[0][2]]
             bands[study.observe[o]] = {
                 "case": worst[study.observe[o]][0]["case"],
-                "center_hz": np.asarray(point.band.values, float),
-                "rms_g": np.asarray(point.band_rms_g.values, float),
-                "limit_g": np.asarray(point.limit_g.values, float),
-                "judged": np.asarray(point.judged.values, bool),
+                "center_hz": rows["center_hz"],
+                "rms_g": rows["band_rms_g"][first],
+                "limit_g": rows["limit_g"],
+                "judged": rows["judged"],
             }
     fraction_by = {
         d: [
@@ -331,16 +337,41 @@ def summarize(
         out=None if result.out is None else str(result.out),
         study=study.to_dict(),
         worst_bands=bands,
+        peaks_certified=certified,
     )
 
 
-def _case_row(result: SweepRecord, ds: Any, case: tuple[int, ...]) -> dict[str, Any]:
+def _case_values(result: SweepRecord, cases: Sequence[tuple[int, ...]]) -> dict[str, Any]:
+    """The stored values of the given cases, in one read of the store.
+
+    ``cases`` maps each case to its row in the arrays ``margin``, ``peak_accel_g``,
+    ``rms_accel_g``, ``complies`` (n,) and ``band_rms_g`` (n, 3, nb); ``center_hz``,
+    ``limit_g`` and ``judged`` (nb,) are the bands'.
+    """
+    import xarray as xr
+
+    names = ("margin", "peak_accel_g", "rms_accel_g", "complies", "band_rms_g")
+    out: dict[str, Any] = {"cases": {c: i for i, c in enumerate(cases)}}
+    ds = result.dataset
+    if cases:
+        idx = np.asarray(cases, int)
+        sel = {d: xr.DataArray(idx[:, k], dims="_case") for k, d in enumerate(CASE_DIMS)}
+        sub = ds[list(names)].isel(sel).transpose("_case", ...).compute()
+        out.update({n: np.asarray(sub[n].values) for n in names})
+    out["center_hz"] = np.asarray(ds.band.values, float)
+    out["limit_g"] = np.asarray(ds.limit_g.values, float)
+    out["judged"] = np.asarray(ds.judged.values, bool)
+    return out
+
+
+def _case_row(result: SweepRecord, rows: dict[str, Any], case: tuple[int, ...]) -> dict[str, Any]:
+    """One worst case's line of the summary, from :func:`_case_values`."""
     study = result.study
     labels = study.case(case)
-    point = ds.isel(dict(zip(CASE_DIMS, case, strict=True)))
-    to = point.band_rms_g.values  # (3, nb)
-    lim = point.limit_g.values
-    judged = point.judged.values.astype(bool)
+    i = rows["cases"][case]
+    to = rows["band_rms_g"][i]  # (3, nb)
+    lim = rows["limit_g"]
+    judged = rows["judged"]
     with np.errstate(divide="ignore", invalid="ignore"):
         margin_b = np.where(to > 0, lim / np.where(to > 0, to, 1.0), np.inf)
     wb = None
@@ -348,7 +379,7 @@ def _case_row(result: SweepRecord, ds: Any, case: tuple[int, ...]) -> dict[str, 
         mm = np.where(judged[None, :], margin_b, np.inf)
         ax, band = np.unravel_index(int(np.argmin(mm)), mm.shape)
         wb = {
-            "center_hz": float(point.band.values[band]),
+            "center_hz": float(rows["center_hz"][band]),
             "axis": "xyz"[ax],
             "rms_g": float(to[ax, band]),
             "limit_g": float(lim[band]),
@@ -356,10 +387,10 @@ def _case_row(result: SweepRecord, ds: Any, case: tuple[int, ...]) -> dict[str, 
     return {
         "case": {k: (float(v) if k == "damping" else v) for k, v in labels.items()},
         "index": [int(i) for i in case],
-        "margin": json_number(float(point.margin.values)),
-        "peak_accel_g": float(point.peak_accel_g.values),
-        "rms_accel_g": float(point.rms_accel_g.values),
-        "complies": bool(point.complies.values),
+        "margin": json_number(float(rows["margin"][i])),
+        "peak_accel_g": float(rows["peak_accel_g"][i]),
+        "rms_accel_g": float(rows["rms_accel_g"][i]),
+        "complies": bool(rows["complies"][i]),
         "worst_band": wb,
         "command": case_command(result, labels),
         "python": case_python(result, labels),
