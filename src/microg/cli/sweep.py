@@ -162,9 +162,9 @@ def sweep(
         + (f" ({result.resumed_blocks} blocks resumed)" if result.resumed_blocks else "")
         + (f", {100 * frac:.1f} % comply with {summary.requirement}" if frac is not None else "")
     )
-    click.echo(f"  exact peaks certified for {summary.peaks_certified:,} of {summary.cases:,} cases "
-               f"(record.peaks = {study.record.peaks}; the others' verdicts do not depend on "
-               "them: their peaks are the sampled record's)")  # fmt: skip
+    click.echo(f"  exact peaks certified for {summary.peaks_certified:,} of {summary.cases:,} "
+               f"cases (record.peaks = {study.record.peaks}; the others' verdicts do not "
+               "depend on them: their peaks are the sampled record's)")  # fmt: skip
     for row in summary.worst_list()[:10]:
         c = row["case"]
         label = ", ".join(f"{k}={c[k]}" for k in c if len(study.coords[k]) > 1) or "the case"

@@ -345,12 +345,12 @@ def _case_values(result: SweepRecord, cases: Sequence[tuple[int, ...]]) -> dict[
     """The stored values of the given cases, in one read of the store.
 
     ``cases`` maps each case to its row in the arrays ``margin``, ``peak_accel_g``,
-    ``rms_accel_g``, ``complies`` (n,) and ``band_rms_g`` (n, 3, nb); ``center_hz``,
-    ``limit_g`` and ``judged`` (nb,) are the bands'.
+    ``rms_accel_g``, ``complies``, ``peak_certified`` (n,) and ``band_rms_g`` (n, 3, nb);
+    ``center_hz``, ``limit_g`` and ``judged`` (nb,) are the bands'.
     """
     import xarray as xr
 
-    names = ("margin", "peak_accel_g", "rms_accel_g", "complies", "band_rms_g")
+    names = ("margin", "peak_accel_g", "rms_accel_g", "complies", "band_rms_g", "peak_certified")
     out: dict[str, Any] = {"cases": {c: i for i, c in enumerate(cases)}}
     ds = result.dataset
     if cases:
@@ -389,6 +389,7 @@ def _case_row(result: SweepRecord, rows: dict[str, Any], case: tuple[int, ...]) 
         "index": [int(i) for i in case],
         "margin": json_number(float(rows["margin"][i])),
         "peak_accel_g": float(rows["peak_accel_g"][i]),
+        "peak_certified": bool(rows["peak_certified"][i]),
         "rms_accel_g": float(rows["rms_accel_g"][i]),
         "complies": bool(rows["complies"][i]),
         "worst_band": wb,
