@@ -47,6 +47,8 @@ thread, so the serial and the distributed paths give the same bits.
 
 from __future__ import annotations
 
+import threading
+from collections import OrderedDict
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -78,6 +80,7 @@ __all__ = [
     "modal_group",
     "compute_block",
     "run_blocks",
+    "clear_groups",
     "catalogue_block",
     "kernel_plan",
     "peak_limits",
@@ -707,10 +710,44 @@ def catalogue_block(basis: Basis, plan: KernelPlan, work: BlockWork) -> BlockRes
     return BlockResult(work.id, values)
 
 
+#: modal groups kept between tasks (a process computes each group's shared work once)
+_GROUPS_KEPT = 4
+_GROUPS: OrderedDict[tuple[int, int, tuple[int, ...]], tuple[Basis, KernelPlan, ModalGroup]] = (
+    OrderedDict()
+)
+_GROUPS_LOCK = threading.Lock()
+
+
+def _group(basis: Basis, plan: KernelPlan, key: tuple[int, ...]) -> ModalGroup:
+    """:func:`modal_group`, kept for the next task of the same basis and plan in this process.
+
+    A group depends only on its basis, plan and indices, so a kept one gives the same bits; the
+    entry holds the basis and plan, so their ids name them while it is kept.
+    """
+    k = (id(basis), id(plan), key)
+    with _GROUPS_LOCK:
+        hit = _GROUPS.get(k)
+        if hit is not None and hit[0] is basis and hit[1] is plan:
+            _GROUPS.move_to_end(k)
+            return hit[2]
+    group = modal_group(basis, plan, *key)
+    with _GROUPS_LOCK:
+        _GROUPS[k] = (basis, plan, group)
+        while len(_GROUPS) > _GROUPS_KEPT:
+            _GROUPS.popitem(last=False)
+    return group
+
+
+def clear_groups() -> None:
+    """Forget the modal groups kept by :func:`run_blocks` (a sweep's end frees them)."""
+    with _GROUPS_LOCK:
+        _GROUPS.clear()
+
+
 def run_blocks(
     basis: Basis, plan: KernelPlan, works: Sequence[BlockWork], threads: int = 1
 ) -> list[BlockResult]:
-    """Compute a batch of blocks of one variant (a task): each modal group once.
+    """Compute a batch of blocks of one variant (a task): each modal group once per process.
 
     Parameters
     ----------
@@ -729,7 +766,7 @@ def run_blocks(
                 continue
             k = w.index[2:5]
             if k != key:
-                group = modal_group(basis, plan, *k)
+                group = _group(basis, plan, k)
                 key = k
             assert group is not None
             out.append(compute_block(basis, plan, group, w))

@@ -35,7 +35,15 @@ from microg import _args
 from microg._io import sigterm_raises
 from microg.errors import InputError, MicrogError
 from microg.study.cases import Block, Study, default_n_modes
-from microg.study.kernel import Basis, BlockWork, KernelPlan, kernel_plan, run_blocks, solve_basis
+from microg.study.kernel import (
+    Basis,
+    BlockWork,
+    KernelPlan,
+    clear_groups,
+    kernel_plan,
+    run_blocks,
+    solve_basis,
+)
 from microg.study.plan import load_study
 from microg.study.store import STORE_NAME, SweepStore
 
@@ -46,6 +54,8 @@ __all__ = [
     "RETRIES",
     "TASK_CASES",
     "CONNECT_TIMEOUT_S",
+    "WORKER_ENVIRON",
+    "worker_environ",
     "SweepIncompleteError",
     "SweepResult",
     "sweep",
@@ -64,6 +74,20 @@ CONNECT_TIMEOUT_S = 10.0
 SCATTER_TIMEOUT_S = 30.0
 #: tasks in flight per worker thread
 IN_FLIGHT_PER_THREAD = 2
+#: glibc malloc settings of the local workers, set before each worker process starts (the
+#: nanny's ``distributed.nanny.pre-spawn-environ``).  distributed ships
+#: ``MALLOC_TRIM_THRESHOLD_=65536``, which returns freed memory to the system after every
+#: large temporary, so a task's next array of a few MB is mapped (and page-faulted) again:
+#: a block's task ran at half its in-process speed.  Trimming above 1 GiB keeps the freed
+#: pages for the next block; a fixed mmap threshold of 32 MiB (glibc's largest on 64 bits)
+#: serves the block-sized arrays from the heap.  docs/scale.md says how to set them for a
+#: cluster's workers.
+WORKER_ENVIRON: dict[str, str] = {
+    "MALLOC_TRIM_THRESHOLD_": str(1 << 30),
+    "MALLOC_MMAP_THRESHOLD_": str(1 << 25),
+}
+#: distributed's own default trim threshold (replaced by :data:`WORKER_ENVIRON`'s)
+_DISTRIBUTED_TRIM = "65536"
 
 TaskFn = Callable[[Basis, KernelPlan, Sequence[BlockWork], int], list[Any]]
 
@@ -353,6 +377,50 @@ def _serial(runner: _Runner, task_fn: TaskFn, threads: int) -> None:
             runner.results(task_fn(basis, plan, works, threads))
 
 
+def worker_environ(current: dict[str, Any] | None = None) -> dict[str, str]:
+    """The ``distributed.nanny.pre-spawn-environ`` of microg's local workers.
+
+    :data:`WORKER_ENVIRON` over distributed's defaults; a value the user set (in the Dask
+    configuration, or in this process's environment, which the nanny reads first) is kept,
+    except distributed's own ``MALLOC_TRIM_THRESHOLD_=65536``.
+
+    Parameters
+    ----------
+    current : the configured ``pre-spawn-environ`` (default: ``dask.config``'s)
+    """
+    import os
+
+    if current is None:
+        import dask
+
+        current = dict(dask.config.get("distributed.nanny.pre-spawn-environ", default={}))
+    env = {k: str(v) for k, v in current.items() if v is not None}
+    for k, v in WORKER_ENVIRON.items():
+        mine = os.environ.get(k, env.get(k))
+        env[k] = v if mine is None or mine == _DISTRIBUTED_TRIM else mine
+    return env
+
+
+@contextmanager
+def _local_environ(env: dict[str, str]) -> Iterator[None]:
+    """``env`` as this process's environment while local workers start.
+
+    The nanny reads the environment before its configuration, and writes its own values there.
+    """
+    import os
+
+    old = {k: os.environ.get(k) for k in env}
+    os.environ.update(env)
+    try:
+        yield
+    finally:
+        for k, v in old.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
+
+
 @contextmanager
 def _client(workers: int | None, scheduler: str | None, timeout_s: float) -> Iterator[Any]:
     try:
@@ -388,13 +456,17 @@ def _client(workers: int | None, scheduler: str | None, timeout_s: float) -> Ite
             client.close()
         return
     assert workers is not None
-    cluster = LocalCluster(
-        n_workers=workers,
-        threads_per_worker=1,
-        processes=True,
-        dashboard_address=None,
-        silence_logs=logging.ERROR,
-    )
+    import dask
+
+    env = worker_environ()
+    with dask.config.set({"distributed.nanny.pre-spawn-environ": env}), _local_environ(env):
+        cluster = LocalCluster(
+            n_workers=workers,
+            threads_per_worker=1,
+            processes=True,
+            dashboard_address=None,
+            silence_logs=logging.ERROR,
+        )
     try:
         client = Client(cluster)
         try:
@@ -660,7 +732,10 @@ def sweep(
             with sigterm_raises(_Terminated):
                 if runner.todo:
                     if client is None:
-                        _serial(runner, task_fn, threads)
+                        try:
+                            _serial(runner, task_fn, threads)
+                        finally:
+                            clear_groups()
                     else:
                         _distributed(runner, client, task_fn, threads)
         except InputError:
