@@ -253,7 +253,7 @@ def _cluster(n: int, microg_env: bool) -> Any:
     env = worker_environ(base) if microg_env else {k: str(v) for k, v in base.items()}
     with dask.config.set({"distributed.nanny.pre-spawn-environ": env}), _local_environ(env):
         return LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                            dashboard_address=None, silence_logs=logging.ERROR)  # fmt: skip
+                            dashboard_address=":0", silence_logs=logging.ERROR)  # fmt: skip
 
 
 def dask_part(n_at: int, rounds: int) -> None:
@@ -319,7 +319,7 @@ def variants_part() -> tuple[dict[int, float], int, int]:
     t0 = time.perf_counter()
     sweep(study)
     times[0] = time.perf_counter() - t0
-    options = {"threads_per_worker": 1, "processes": True, "dashboard_address": None}
+    options = {"threads_per_worker": 1, "processes": True, "dashboard_address": ":0"}
     for n in (1, 2):
         with LocalCluster(n_workers=n, silence_logs=logging.ERROR, **options) as cluster:
             sweep(warm, scheduler=cluster.scheduler_address)  # the workers import microg

@@ -84,7 +84,7 @@ def test_two_local_workers_give_the_serial_bits(serial, monkeypatch) -> None:
 @pytest.fixture
 def cluster():
     with distributed.LocalCluster(
-        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0",
         silence_logs=50,
     ) as c:  # fmt: skip
         yield c

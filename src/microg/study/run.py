@@ -464,7 +464,7 @@ def _client(workers: int | None, scheduler: str | None, timeout_s: float) -> Ite
             n_workers=workers,
             threads_per_worker=1,
             processes=True,
-            dashboard_address=None,
+            dashboard_address=":0",  # any free port: 8787 may be taken
             silence_logs=logging.ERROR,
         )
     try:
