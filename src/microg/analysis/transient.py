@@ -148,11 +148,19 @@ def transient(
             req,
             package_mass=opts.package_mass_kg,
             absorber_mu=opts.absorber_mu,
+            sources=mount_sources,
         )
         return replace(ob, isolation=adv)
 
     obs = [observe(j, name) for j, name in enumerate(names)]
     step("isolation")
+    mount_sources = None
+    if opts.sources is not None:
+        from microg.isolation.active.sourcecheck import MountSources
+
+        # the active check (when one is made) verifies the platform on the sources too, with
+        # every mode, as the frequency-domain block does
+        mount_sources = MountSources(modes, opts.sources, np.where(modes.rigid, 0.0, opts.zeta))
     if opts.isolation:
         obs = [isolate(ob) for ob in obs]
     observations = {ob.name: ob for ob in obs}

@@ -10,11 +10,17 @@ every spectrum's ``int S df``: the rule of order ``2 order`` on the same interva
 exact power of the spectrum; a band that fails has its intervals halved (up to
 :data:`MAX_REFINEMENTS` times) and a band that still fails is named in the warnings
 (:func:`converged_quadrature`).
+
+With a real weight per output row ``w_p(f)`` (an isolator's ``|T|^2``) the check is made on the
+weighted integrands: ``int w_p |r_j|^2 df`` of every near mode and ``int w_p S df`` of every
+spectrum, each by the rules of order ``order`` and ``2 order`` (a weighted power has no exact
+value), beside the exact power of each unweighted spectrum; the weight's own breakpoints (the
+loop's poles) join the intervals' breakpoints.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -185,6 +191,9 @@ def converged_quadrature(
     spectra: Sequence[ForceSpectrum],
     order: int,
     rtol: float,
+    *,
+    weight: Callable[[np.ndarray], np.ndarray] | None = None,
+    breakpoints_hz: Sequence[float] | np.ndarray = (),
 ) -> tuple[BandQuadrature, np.ndarray, int, list[str]]:
     """Nodes that pass the convergence check; per-band relative error; refinements; warnings.
 
@@ -198,6 +207,9 @@ def converged_quadrature(
     spectra : the spectral sources (their breakpoints and exact powers), N and Hz
     order : Gauss-Legendre points per sub-interval
     rtol : relative tolerance of the check
+    weight : a real weight per output row, frequencies (n,) Hz -> (p, n) values >= 0; the check
+        is then made on the weighted integrands (module docstring); None: no weight
+    breakpoints_hz : extra breakpoints (where the weight changes quickly), Hz
 
     Returns
     -------
@@ -206,8 +218,8 @@ def converged_quadrature(
     refinements : interval halvings done
     warnings : the bands that did not converge
     """
-    bps = [s.breakpoints_hz for s in spectra]
-    bp = np.unique(np.concatenate(bps)) if bps else np.zeros(0)
+    bps = [s.breakpoints_hz for s in spectra] + [np.asarray(breakpoints_hz, float).ravel()]
+    bp = np.unique(np.concatenate(bps))
     fm = omega_modes / (2.0 * np.pi)
     iv = _band_intervals(lower_hz, upper_hz, fm, zeta, bp)
     nb = lower_hz.size
@@ -229,20 +241,28 @@ def converged_quadrature(
         sub = iv[np.isin(iv[:, 0].astype(int), todo)]
         q1 = _gauss_nodes(sub, order, nb)
         e = np.zeros(nb)
+        q2 = _gauss_nodes(sub, 2 * order, nb) if weight is not None or np.any(near) else q1
+        wq = (
+            [np.ones((1, q1.freq_hz.size)), np.ones((1, q2.freq_hz.size))]
+            if weight is None
+            else [weight(q1.freq_hz), weight(q2.freq_hz)]
+        )
         if np.any(near[:, todo]):
-            q2 = _gauss_nodes(sub, 2 * order, nb)
             diags = []
-            for q in (q1, q2):
+            for q, wr in zip((q1, q2), wq, strict=True):
                 jj, nn = np.nonzero(near[:, q.band])
                 re, im = factor(wm[jj], zm[jj], 2.0 * np.pi * q.freq_hz[nn])
                 val = (re * re + im * im) * q.weight_hz[nn] * sc2[jj]
-                flat = np.bincount(jj * nb + q.band[nn], weights=val, minlength=wm.size * nb)
-                diags.append(flat.reshape(wm.size, nb))
+                flat = [
+                    np.bincount(jj * nb + q.band[nn], weights=val * row[nn], minlength=wm.size * nb)
+                    for row in wr
+                ]
+                diags.append(np.array(flat).reshape(len(wr), wm.size, nb))
             d1, d2 = diags
-            big = near & (d2 >= 1e-13 * np.max(d2, axis=0, keepdims=True))
+            big = near[None] & (d2 >= 1e-13 * np.max(d2, axis=1, keepdims=True))
             with np.errstate(divide="ignore", invalid="ignore"):
                 rel = np.where(big & (d2 > 0), np.abs(d1 - d2) / d2, 0.0)
-            e = rel.max(axis=0)
+            e = rel.max(axis=(0, 1))
         if spectra:
             sp = np.array([s.psd_at(q1.freq_hz) for s in spectra]) * q1.weight_hz[None, :]
             got = per_band(sp, q1.start)
@@ -251,6 +271,17 @@ def converged_quadrature(
             with np.errstate(divide="ignore", invalid="ignore"):
                 srel = np.where(denom > 0, np.abs(got - exact) / denom, 0.0)
             e = np.maximum(e, srel.max(axis=0))
+            if weight is not None:  # the weighted powers by the two rules
+                pw = []
+                for q, wr in zip((q1, q2), wq, strict=True):
+                    psd = np.array([s.psd_at(q.freq_hz) for s in spectra]) * q.weight_hz[None, :]
+                    pw.append(per_band(psd[None, :, :] * wr[:, None, :], q.start))  # (p, s, nb)
+                w1, w2 = pw
+                wtop = np.max(w2, axis=(0, 1), keepdims=True)
+                big = w2 >= 1e-13 * wtop
+                with np.errstate(divide="ignore", invalid="ignore"):
+                    wrel = np.where(big & (w2 > 0), np.abs(w1 - w2) / w2, 0.0)
+                e = np.maximum(e, wrel.max(axis=(0, 1)))
         err[todo] = e[todo]
         bad = todo[err[todo] > rtol]
         if bad.size == 0 or attempt == MAX_REFINEMENTS:

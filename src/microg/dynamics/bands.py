@@ -13,12 +13,19 @@ within two band widths of the band node by node, the others -- smooth over the b
 16-point Chebyshev interpolant of their sum, each far mode's interpolant checked at 49 points
 across the band to 1e-14 of the mode's size there (a mode that fails is summed node by node).
 Harmonic lines are evaluated exactly at their frequencies.
+
+An optional real **weight** per output row, ``w_p(f) >= 0`` (e.g. ``|T(f)|^2``, the squared
+transmissibility of an isolator on the observed point), multiplies the integrand of row ``p``:
+``int w_p(f) |H_p(f)|^2 S(f) df``.  The responses at the quadrature nodes are scaled by
+``sqrt(w_p)`` at each node's own frequency and a harmonic line's by ``sqrt(w_p)`` at the line's
+frequency, so the combination over sources and the contributions keep their meaning; the
+convergence check of :mod:`microg.dynamics.bandquad` is then made on the weighted integrand.
 """
 
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
@@ -29,7 +36,10 @@ from microg.dynamics.frf import factor_parts
 from microg.dynamics.spectra import ForceSpectrum, HarmonicLines, same_frequency_index
 from microg.errors import InputError
 
-__all__ = ["MAX_LINES", "BandArrays", "band_mean_squares"]
+__all__ = ["MAX_LINES", "BandArrays", "RowWeight", "band_mean_squares"]
+
+#: a real weight per output row: frequencies (n,) in Hz -> (p, n) values >= 0
+RowWeight = Callable[[np.ndarray], np.ndarray]
 
 #: largest number of harmonic lines over all sources
 MAX_LINES = 100_000
@@ -134,6 +144,7 @@ def _spectral_band(
     zm: np.ndarray,
     near: np.ndarray,
     contributions: bool = True,
+    sw: np.ndarray | None = None,
 ) -> _BandPart:
     """Mean squares in one band from spectral sources (node by node, in amplitude).
 
@@ -142,7 +153,8 @@ def _spectral_band(
     the band enter through a 16-point interpolant of their (smooth) sum, each far mode's
     interpolant checked at 49 points across the band to ``_CHEB_TOL`` (a mode that fails is
     summed node by node).  Amplitudes, not squares, are summed, so a response that is small by
-    cancellation between modes keeps its relative accuracy.
+    cancellation between modes keeps its relative accuracy.  ``sw`` (p, nn): the square root of
+    each row's weight at the nodes (None: no weight).
     """
     p, m = T.shape
     L, nn = amp.shape
@@ -182,6 +194,9 @@ def _spectral_band(
         cre_re = cre_im = cn
     Hre = cre_re @ Rre  # (L, p, nn)
     Him = cre_im @ Rim
+    if sw is not None:  # the weighted responses sqrt(w_p) H_p
+        Hre = Hre * sw[None]
+        Him = Him * sw[None]
     ug, ginv = np.unique(gl, return_inverse=True)
     ginv = ginv.reshape(-1)
     alone = np.einsum("spn,spn->ps", Hre, Hre) + np.einsum("spn,spn->ps", Him, Him)
@@ -211,12 +226,14 @@ def _spectral_band(
     # mode shares: T_pj sum_s F_sj Re sum_n r_j(n) amp_s(n) conj(Y_g(s)(n)); the sums over the
     # nodes are products with the amplitude-scaled basis: near columns give the near modes, the
     # Chebyshev columns the far modes through r_j(n) ~ sum_k r_j(x_k) l_k(n)
+    # (a weight enters once more: the mode's term is weighted as the total it projects on)
     RreT, RimT = np.swapaxes(Rre, 1, 2), np.swapaxes(Rim, 1, 2)
-    Are = Hre @ RreT  # (L, p, K): sum_n Yre a b, Y = H for a source alone in its group
-    Aim = Him @ RimT
+    w1 = 1.0 if sw is None else sw[None]
+    Are = (Hre * w1) @ RreT  # (L, p, K): sum_n Yre a b, Y = H for a source alone in its group
+    Aim = (Him * w1) @ RimT
     if multi.size:
-        Are[multi] = Ym_re @ RreT[multi]
-        Aim[multi] = Ym_im @ RimT[multi]
+        Are[multi] = (Ym_re * w1) @ RreT[multi]
+        Aim[multi] = (Ym_im * w1) @ RimT[multi]
     if mn:
         W = Are[:, :, :mn] + Aim[:, :, :mn]  # Re(conj(Y) a r_j)
         mode_share[:, nr] = T[:, nr] * np.einsum("sj,spj->pj", F[:, nr], W)
@@ -228,13 +245,21 @@ def _spectral_band(
         mode_share[:, far] = T[:, far] * Wf
     # modes alone: T_pj^2 sum_g int |r_j|^2 |sum_{s in g} F_sj a_s|^2
     rr = rre * rre + rim * rim  # (m, nn)
-    D = rr @ (amp * amp).T  # (m, L)
-    A = np.sum(F.T**2 * D, axis=1)
+    if sw is None:
+        D = rr @ (amp * amp).T  # (m, L)
+        A = np.sum(F.T**2 * D, axis=1)[None, :]  # (1, m)
+    else:  # per row: int w_p |r_j|^2 ...
+        D = np.einsum("jn,pn,sn->pjs", rr, sw * sw, amp * amp)  # (p, m, L)
+        A = np.sum(F.T[None] ** 2 * D, axis=2)  # (p, m)
     if multi.size:
         ia, ib = np.nonzero((ginv[:, None] == ginv[None, :]) & ~np.eye(L, dtype=bool))
-        cross = rr @ (amp[ia] * amp[ib]).T  # (m, P)
-        A += np.sum(F[ia].T * F[ib].T * cross, axis=1)
-    mode_alone = T**2 * A[None, :]
+        if sw is None:
+            cross = rr @ (amp[ia] * amp[ib]).T  # (m, P)
+            A = A + np.sum(F[ia].T * F[ib].T * cross, axis=1)[None, :]
+        else:
+            cross_w = np.einsum("jn,pn,kn->pjk", rr, sw * sw, amp[ia] * amp[ib])
+            A = A + np.sum((F[ia].T * F[ib].T)[None] * cross_w, axis=2)
+    mode_alone = T**2 * A
     return _BandPart(
         total=gms.sum(axis=1),
         source_alone=alone,
@@ -261,6 +286,8 @@ def band_mean_squares(
     rtol: float = 1e-9,
     workers: int | None = None,
     contributions: bool = True,
+    weight: RowWeight | None = None,
+    weight_breakpoints_hz: Sequence[float] | np.ndarray = (),
 ) -> BandArrays:
     """Band mean squares, their combination over sources and the contributions (pure kernel).
 
@@ -279,6 +306,10 @@ def band_mean_squares(
     workers : threads over bands (default the number of CPUs); BLAS keeps the process's threads
     contributions : compute the per-mode contributions (``mode_alone``, ``mode_share``; zero
         when False, about half the work)
+    weight : a real weight per output row (module docstring): ``weight(f_hz)`` for (n,)
+        frequencies, Hz, returns (p, n) values >= 0 (dimensionless for ``|T|^2``); None: 1
+    weight_breakpoints_hz : frequencies where the weight changes quickly (e.g. the poles of the
+        isolator's loop), Hz: breakpoints of the quadrature
 
     Returns
     -------
@@ -297,6 +328,16 @@ def band_mean_squares(
     if not (np.all(lo > 0) and np.all(hi > lo)):
         raise InputError("bands need 0 < lower < upper", where="bands")
     gidx = _group_index(groups, ns)
+
+    def weight_at(freq: np.ndarray) -> np.ndarray:
+        assert weight is not None
+        w = np.asarray(weight(np.asarray(freq, float)), float)
+        if w.shape != (p, freq.size) or not np.all(np.isfinite(w)) or np.any(w < 0):
+            raise InputError(
+                f"must return ({p}, n) finite values >= 0 for n frequencies", where="weight"
+            )
+        return w
+
     ng = int(gidx.max()) + 1 if ns else 0
     total = np.zeros((p, nb))
     src_alone = np.zeros((p, ns, nb))
@@ -318,12 +359,22 @@ def band_mean_squares(
         scale = np.max(np.abs(T), axis=0) * np.max(np.abs(Fs), axis=0)  # (m,) max |c_j|
         spec_list = [spectra[i] for i in spec_idx]
         quad, qerr, refinements, w = converged_quadrature(
-            lo, hi, wm, zm, scale, spec_list, order, rtol
+            lo,
+            hi,
+            wm,
+            zm,
+            scale,
+            spec_list,
+            order,
+            rtol,
+            weight=None if weight is None else weight_at,
+            breakpoints_hz=weight_breakpoints_hz,
         )
         warnings += w
         quad_nodes = int(quad.freq_hz.size)
         S = np.array([s.psd_at(quad.freq_hz) for s in spec_list])  # (ss, N), N^2/Hz
         re_all, im_all = factor_parts(wm, zm, 2.0 * np.pi * quad.freq_hz)  # (m, N)
+        sw_all = None if weight is None else np.sqrt(weight_at(quad.freq_hz))  # (p, N)
         fm = wm / (2.0 * np.pi)
         elastic = wm > 0
         gs = gidx[spec_idx]
@@ -349,6 +400,7 @@ def band_mean_squares(
                 wm,
                 zm,
                 elastic & (fm > lo[b] - _NEAR_WIDTHS * width) & (fm < hi[b] + _NEAR_WIDTHS * width),
+                sw=None if sw_all is None else sw_all[:, n0:n1],
             )
             return b, live, part
 
@@ -405,6 +457,9 @@ def band_mean_squares(
         np.add.at(B.T, key, F[src] * al[:, None])
         Y = T @ (r * B)  # (p, U) group response phasors (RMS)
         Hs = T @ (r[:, key] * F[src].T * al[None, :])  # (p, lines): each line alone
+        swl = np.ones((p, nu)) if weight is None else np.sqrt(weight_at(fu))  # at each line
+        Y = Y * swl
+        Hs = Hs * swl[:, key]
         # each source's lines at one frequency add first (a source's own phasor sum)
         sk = src * nu + key
         uk, inv = np.unique(sk, return_inverse=True)
@@ -426,7 +481,7 @@ def band_mean_squares(
         grp += np.einsum("pu,ug,ub->pgb", gms, Mg, Mf)
         for c0 in range(0, nu if contributions else 0, 256):  # chunks keep (p, m, chunk) small
             c1 = min(nu, c0 + 256)
-            term = T[:, :, None] * (r[:, c0:c1] * B[:, c0:c1])[None]  # (p, m, u)
+            term = T[:, :, None] * (r[:, c0:c1] * B[:, c0:c1])[None] * swl[:, None, c0:c1]
             mode_alone += np.abs(term) ** 2 @ Mf[c0:c1]
             mode_share += np.real(term * np.conj(Y[:, None, c0:c1])) @ Mf[c0:c1]
 

@@ -526,6 +526,8 @@ def band_response(
     rtol: float = 1e-9,
     workers: int | None = None,
     contributions: bool = True,
+    weight: Any = None,
+    weight_breakpoints_hz: Sequence[float] | np.ndarray = (),
 ) -> BandResponse:
     """Band RMS acceleration at observed points under force spectra at named points.
 
@@ -538,6 +540,9 @@ def band_response(
     lower_hz, upper_hz : (nb,) band edges, Hz
     center_hz : (nb,) band centres for output (default the geometric mean of the edges)
     order, rtol, workers, contributions : see :func:`band_mean_squares`
+    weight, weight_breakpoints_hz : a real weight per output row (3 per observed point, x y z)
+        and its breakpoints, Hz; see :func:`band_mean_squares` (e.g. ``|T_axis(f)|^2`` of an
+        isolator on the point: the RMS is then the isolated platform's)
 
     Returns
     -------
@@ -578,6 +583,8 @@ def band_response(
         rtol=rtol,
         workers=workers,
         contributions=contributions,
+        weight=weight,
+        weight_breakpoints_hz=weight_breakpoints_hz,
     )
     warnings = list(arr.warnings)
     unstable = np.asarray(modes.unstable, bool)

@@ -270,6 +270,8 @@ def assess_sources(
     duty_weighted: bool = False,
     max_modes: int = MAX_MODES_LISTED,
     workers: int | None = None,
+    weight: Any = None,
+    weight_breakpoints_hz: Sequence[float] | np.ndarray = (),
 ) -> VibratoryAssessment:
     """Frequency-domain vibratory assessment of ``observe`` under the catalogue's sources.
 
@@ -285,6 +287,10 @@ def assess_sources(
     duty_weighted : scale each source's mean square by its ``duty`` (default: full level)
     max_modes : modes listed per band in the contributions of :meth:`VibratoryAssessment.to_dict`
     workers : threads over bands (default the CPU count)
+    weight, weight_breakpoints_hz : a real weight per output row (x, y, z of each observed
+        point) on the band integrand, and its breakpoints, Hz
+        (:func:`~microg.dynamics.bands.band_mean_squares`): ``|T_axis(f)|^2`` of an isolator
+        assesses its platform instead of the point
 
     Returns
     -------
@@ -332,6 +338,8 @@ def assess_sources(
         bands.upper_hz,
         center_hz=bands.center_hz,
         workers=workers,
+        weight=weight,
+        weight_breakpoints_hz=weight_breakpoints_hz,
     )
     warnings += list(resp.warnings)
     out_of_band = _outside_bands(on, req)

@@ -286,6 +286,7 @@ def _active_dict(act: ActiveIsolation) -> dict[str, Any]:
         "force_limit_N": full["force_limit_N"],
         "attenuation_at_0_1_hz": full["attenuation_at_0_1_hz"],
         "worst_band": tc.get("worst_band"),
+        "sources": full["sources"],
         "notes": list(act.notes),
     }
 
@@ -296,6 +297,7 @@ def _active_check(
     requirement: Requirement,
     need: dict[float, float],
     edges: dict[float, tuple[float, float]],
+    sources: Any = None,
 ) -> tuple[ActiveIsolation | None, str]:
     """The default active isolator for ``need``, verified on ``response``: (result, sentence)."""
     from microg.isolation.active.design import design_active
@@ -309,6 +311,7 @@ def _active_check(
             base_accel=response.acceleration,
             point=point,
             requirement=requirement,
+            sources=sources,
         )
     except InputError as exc:
         return (
@@ -395,6 +398,7 @@ def advise_isolation(
     *,
     package_mass: float,
     absorber_mu: float | None = None,
+    sources: Any = None,
 ) -> IsolationAdvice:
     """Isolation advice for one point (the policy of the module docstring).
 
@@ -411,6 +415,9 @@ def advise_isolation(
         Experiment package mass, kg.
     absorber_mu : float, optional
         Absorber mass ratio for the report-rule design.
+    sources : MountSources, optional
+        The station's modes and vibratory sources: the active isolator's check then includes
+        their band verdict on the platform (:mod:`microg.isolation.active.sourcecheck`).
     """
     from microg.environment.metrics import assess
     from microg.isolation.design import design_mount
@@ -441,7 +448,7 @@ def advise_isolation(
             package_mass, (2 * np.pi * lo, 2 * np.pi * hi), min(target, 1.0), mu=absorber_mu
         )
     except InputError as exc:
-        act, sentence = _active_check(point, response, requirement, need, edges)
+        act, sentence = _active_check(point, response, requirement, need, edges, sources)
         ok_act = act is not None and act.complies
         return IsolationAdvice(
             point,
@@ -522,7 +529,7 @@ def advise_isolation(
         )
     act = None
     if status == "no-passive-mount":
-        act, sentence = _active_check(point, response, requirement, need, edges)
+        act, sentence = _active_check(point, response, requirement, need, edges, sources)
         if act is not None and act.complies:
             status = "active-recommended"
         note = f"{note}; {sentence}"

@@ -7,7 +7,10 @@ direct-disturbance response, the sensors' noise floor against the requirement's 
 given the station's acceleration at the mount point, the time-domain response through the
 closed loop (stroke and force against their limits, the band verdict with the noise floor
 added in quadrature) beside the frequency-domain path of the same record
-(``S_out,i = sum_j |T_ij|^2 S_j``, axes taken as uncorrelated).
+(``S_out,i = sum_j |T_ij|^2 S_j``, axes taken as uncorrelated), and, given the station's
+vibratory sources (:class:`~microg.isolation.active.sourcecheck.MountSources`), their band
+table and verdict at the mount point through the closed loop
+(:mod:`~microg.isolation.active.sourcecheck`).
 
 A design's **binding limit** is the first exceeded of: ``umbilical`` (the target is not met:
 the umbilicals' path, attenuated by all the loop gain the sensors, the delay and the platform
@@ -35,6 +38,7 @@ from microg.isolation.active.controller import (
 )
 from microg.isolation.active.plant import ActivePlant
 from microg.isolation.active.result import ActiveIsolation, TimeCheck
+from microg.isolation.active.sourcecheck import MountSources, sources_check
 from microg.isolation.active.target import (
     F_TOP_HZ,
     PASS_LEVEL,
@@ -125,6 +129,7 @@ def design_active(
     requirement: Any = defaults.REQUIREMENT,
     freq_hz: np.ndarray | None = None,
     pade_order: int = 3,
+    sources: MountSources | None = None,
 ) -> ActiveIsolation:
     """Design an active isolator and verify it (module docstring).
 
@@ -140,6 +145,8 @@ def design_active(
     requirement : the band requirement (name or object) of the noise and time checks
     freq_hz : frequencies of the curves, Hz (default :func:`default_freq_hz`)
     pade_order : order of the delay's Pade approximant (continuous model)
+    sources : the station's modes and vibratory sources; ``point`` must then be a point of
+        its model: the sources' band table and verdict on the platform (``result.sources``)
     """
     from microg.environment.metrics import Spectrum, acceleration_psd, assess, band_rms
     from microg.environment.requirements import requirement as requirement_by_name
@@ -266,6 +273,14 @@ def design_active(
                 f"actuator {'force' if j < 3 else 'torque'} {time.peak_force[j]:.3g} on "
                 f"{['x', 'y', 'z', 'rx', 'ry', 'rz'][j]} exceeds the limit {force_lim[j]:.3g}"
             )
+    src_check = None
+    if sources is not None:
+        src_check = sources_check(cl, sources, point, req, nb_rms)
+        if src_check.cross_axis_ratio > 1e-3:
+            notes.append(
+                f"sources check: cross-axis transmissibility up to {src_check.cross_axis_ratio:.3g}"
+                " of the direct one is left out (each axis is weighted by |T_ii|^2)"
+            )
     if np.any(nb_rms > req.limit_g[None, :]):
         exceeded.append("sensor_noise")
         j = int(np.argmax(np.max(nb_rms, axis=0) / req.limit_g))
@@ -294,6 +309,7 @@ def design_active(
         target_ratio=ratio,
         passes_quasi_steady=passes_qs,
         time=time,
+        sources=src_check,
         meets_target=False,
         binding_limit=exceeded[0] if exceeded else None,
         limits_exceeded=tuple(exceeded),

@@ -11,6 +11,7 @@ import numpy as np
 from microg.environment.metrics import json_number
 from microg.isolation.active.controller import GM_MIN, PM_MIN_DEG, Controller
 from microg.isolation.active.plant import DOF_NAMES, ActivePlant
+from microg.isolation.active.sourcecheck import SourcesCheck
 from microg.isolation.active.target import Target
 from microg.isolation.active.verify import LoopMargin
 from microg.units import G0
@@ -132,6 +133,8 @@ class ActiveIsolation:
     passes_quasi_steady : |T_ii| >= the pass level a decade below the target's corner
         (None when the target has no quasi-steady corner)
     time : the time-domain check, or None without a station response
+    sources : the station's vibratory sources at the mount point through the closed loop
+        (band table and verdict), or None without sources
     meets_target : stable, margins kept, the target met, and (with a time check) stroke and
         force within their limits and the noise floor below the requirement
     binding_limit : the first of :data:`BINDING_LIMITS` that is exceeded, or None
@@ -158,6 +161,7 @@ class ActiveIsolation:
     target_ratio: np.ndarray
     passes_quasi_steady: bool | None
     time: TimeCheck | None
+    sources: SourcesCheck | None
     meets_target: bool
     binding_limit: str | None
     limits_exceeded: tuple[str, ...]
@@ -190,9 +194,12 @@ class ActiveIsolation:
         """The platform meets the requirement at the mount point, every limit kept.
 
         The time check (noise included) complies, the design is stable with its margins kept,
-        and the stroke and force stay within their limits.
+        the stroke and force stay within their limits, and, when the sources were checked,
+        their band verdict on the platform (noise included) complies too.
         """
         if self.time is None or not self.stable or not self.margins_kept:
+            return False
+        if self.sources is not None and not self.sources.complies:
             return False
         stroke, force = self.plant.limits()
         return (
@@ -275,6 +282,7 @@ class ActiveIsolation:
             "stroke_limit_m": float(stroke_lim[0]),
             "force_limit_N": float(force_lim[0]),
             "time_check": None if tm is None else tm.to_dict(),
+            "sources": None if self.sources is None else self.sources.to_dict(),
             "notes": list(self.notes),
         }
         return out
