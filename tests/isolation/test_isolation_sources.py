@@ -137,6 +137,9 @@ def test_result_contract_and_verdict(modes) -> None:
     # the noise floor is added in quadrature, as in the time check
     comb = np.sqrt(r.sources.platform.rms_g[0] ** 2 + r.noise_band_rms_g**2)
     assert np.allclose(r.sources.combined_rms_g, comb, rtol=1e-14)
+    ds = r.to_xarray()
+    assert np.allclose(ds["sources_platform_rms_g"].values, r.sources.platform.rms_g[0])
+    assert ds["sources_limit_g"].attrs["units"] == "g"
     # a failing sources check makes the whole isolator fail
     failing = replace(r, sources=replace(r.sources, complies=False))
     assert failing.complies is False

@@ -331,6 +331,16 @@ class ActiveIsolation:
                 tm.force,
                 {"units": "N (x, y, z); N m (rx, ry, rz)"},
             )
+        sc = self.sources
+        if sc is not None:
+            coords["band_center_hz"] = ("band_center_hz", sc.platform.center_hz, {"units": "Hz"})
+            for name, values in (
+                ("sources_base_rms_g", sc.base.rms_g[0]),
+                ("sources_platform_rms_g", sc.platform.rms_g[0]),
+                ("sources_combined_rms_g", sc.combined_rms_g),
+            ):
+                data[name] = (("axis", "band_center_hz"), values, {"units": "g"})
+            data["sources_limit_g"] = ("band_center_hz", sc.platform.limit_g, {"units": "g"})
         return xr.Dataset(
             data,
             coords=coords,
