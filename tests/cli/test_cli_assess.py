@@ -285,3 +285,63 @@ def test_a_measured_tone_near_a_band_edge_keeps_its_whole_rms(tmp_path: Path, ca
     assert to["rms_g_axis"]["x"][b - 1] < 1e-6 * 2.4e-6
     assert to["resolved"][b] and to["margin_axis"]["x"][b] < 1.0
     assert o["complies"] is False
+
+
+@pytest.fixture(scope="module")
+def prediction(tmp_path_factory) -> Path:
+    """results.json of `microg analyze` on the IOC model (one observed point, lab)."""
+    out_dir = tmp_path_factory.mktemp("pred") / "run"
+    assert main(["analyze", "--duration", "100 s", "--out", str(out_dir)]) == 0
+    return out_dir / "results.json"
+
+
+def test_predicted_overlays_the_prediction_band_by_band(
+    tmp_path: Path, csv_file: Path, prediction: Path, capsys
+) -> None:
+    out_dir = tmp_path / "ov"
+    args = ["assess", str(csv_file), "--predicted", str(prediction), "--out", str(out_dir)]
+    rc, out, err = _run(capsys, args)
+    assert rc == 0, err
+    assert f"prediction {prediction} at lab: measured/predicted" in out
+    d = json.loads((out_dir / "results.json").read_text())
+    ov = d["prediction"]["sensor"]
+    assert ov["point"] == "lab" and ov["requirement"] == "iss"
+    pred = json.loads(prediction.read_text())["observations"]["lab"]["third_octave"]
+    meas = d["observations"]["sensor"]["third_octave"]
+    # the bands both tables hold (the measurement's stop at its 25-Hz Nyquist frequency): the
+    # same numbers as each side's own results, copied, so equal to JSON's round trip
+    assert ov["center_hz"] == meas["center_hz"] == pred["center_hz"][: len(meas["center_hz"])]
+    assert ov["predicted_g"] == pred["rms_g"][: len(ov["center_hz"])]
+    assert ov["measured_g"] == meas["rms_g"]
+    i = ov["center_hz"].index(2.0)  # the record's 20 micro-g tone
+    assert ov["ratio"][i] == pytest.approx(meas["rms_g"][i] / pred["rms_g"][i], rel=1e-12)
+    assert ov["worst_ratio_band_hz"] == 2.0
+    assert "sensor-prediction-overlay.png" in {p.name for p in out_dir.iterdir()}
+    html = (out_dir / "report.html").read_text()
+    assert "Prediction at lab beside the measurement" in html and "measured / predicted" in html
+
+
+def test_bad_predicted(tmp_path: Path, csv_file: Path, prediction: Path, capsys) -> None:
+    err = _bad(tmp_path, capsys, [str(csv_file), "--predicted", str(csv_file)], "--predicted")
+    assert "not a microg result" in err
+    measured = tmp_path / "measured.json"
+    assert main(["assess", str(csv_file), "--out", str(tmp_path / "m")]) == 0
+    capsys.readouterr()
+    measured.write_text((tmp_path / "m" / "results.json").read_text())
+    err = _bad(tmp_path, capsys, [str(csv_file), "--predicted", str(measured)], "--predicted")
+    assert "microg assess result" in err
+    ok = [str(csv_file), "--predicted", str(prediction)]
+    err = _bad(tmp_path, capsys, [*ok, "--requirement", "ssp41000"], "--requirement")
+    assert "'iss'" in err and "'ssp41000'" in err
+    err = _bad(tmp_path, capsys, [*ok, "--observe", "crew"], "--observe")
+    assert "no point 'crew'" in err and "lab" in err
+    two = json.loads(prediction.read_text())
+    two["observations"]["crew"] = two["observations"]["lab"]
+    several = tmp_path / "two.json"
+    several.write_text(json.dumps(two))
+    err = _bad(tmp_path, capsys, [str(csv_file), "--predicted", str(several)], "--observe")
+    assert "2 points (lab, crew)" in err
+    rc, out, err = _run(capsys, ["assess", str(csv_file), "--predicted", str(several),
+                                 "--observe", "crew", "--json"])
+    assert rc == 0 and json.loads(out)["prediction"]["sensor"]["point"] == "crew"
+    _bad(tmp_path, capsys, [str(csv_file), "--observe", "lab"], "--observe")

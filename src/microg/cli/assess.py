@@ -23,6 +23,8 @@ FLAGS = {
     "psd_method": "--psd",
     "transient": "--transient",
     "out": "--out",
+    "predicted": "--predicted",
+    "point": "--observe",
 }
 
 
@@ -72,6 +74,21 @@ FLAGS = {
     show_default="the file's",
     help="Name of the record in the output (files of one record).",
 )
+@click.option(
+    "--predicted",
+    type=PathType(exists=True, dir_okay=False, path_type=Path),
+    default=None,
+    help="results.json of a `microg analyze` run: its bands are overlaid on the "
+    "measurement's, band by band (table, figure, JSON `prediction`).",
+)
+@click.option(
+    "--observe",
+    "point",
+    default=None,
+    cls=Option,
+    show_default="the point named like the sensor, or the prediction's only point",
+    help="--predicted: the predicted point to compare with.",
+)
 @click.option("--json", "as_json", is_flag=True, help="Print the results as JSON to stdout.")
 @click.option(
     "--out",
@@ -88,6 +105,8 @@ def assess(
     segment: float | None,
     transient: str,
     sensor: str | None,
+    predicted: Path | None,
+    point: str | None,
     as_json: bool,
     out_dir: Path | None,
 ) -> None:
@@ -98,7 +117,8 @@ def assess(
     or a UFF file of time histories (.unv/.uff, datasets 58 with 164 units: x, y, z of each
     node, every sensor assessed).  Prints the band verdict, the PIMS-style interval
     statistics and the transient criteria; --json prints the observations contract of
-    `microg analyze`, keyed by sensor name.
+    `microg analyze`, keyed by sensor name.  --predicted RESULTS.json sets a prediction's
+    1/3-octave bands beside the measurement's (worst axis of each, and their ratio).
     """
     from microg._io import check_writable, dumps
     from microg.cli._errors import flag_errors
@@ -111,6 +131,19 @@ def assess(
     with flag_errors(FLAGS):
         if out_dir is not None:
             check_writable(out_dir, "out")  # before computing anything
+        prediction = None
+        if predicted is not None:
+            from microg.environment.overlay import read_prediction
+
+            prediction = read_prediction(predicted)
+        elif point is not None:
+            from microg.errors import InputError
+
+            raise InputError(
+                "chooses the predicted point, and no prediction is given",
+                where="point",
+                fix="add --predicted RESULTS.json or leave --observe out",
+            )
         records = read_measured_all(file)
         if sensor is not None and len(records) > 1:
             from microg.errors import InputError
@@ -134,6 +167,18 @@ def assess(
             )
             for record in records
         ]
+        if prediction is not None:
+            from microg.environment.overlay import band_overlay
+
+            for r in results:
+                r["overlay"] = band_overlay(
+                    prediction,
+                    r["assessment"],
+                    point=point,
+                    sensor=r["key"],
+                    path=str(predicted),
+                )
+                r["json"]["prediction"] = {r["key"]: r["overlay"].to_dict()}
         payload = merge_assessments(results)
         if out_dir is not None:
             from microg._io import write_output_files
@@ -185,6 +230,11 @@ def merge_assessments(results: list[dict[str, Any]]) -> dict[str, Any]:
         "requirement_source": docs[0]["requirement_source"],
         "observations": {k: d["observations"][k] for k, d in zip(keys, docs, strict=True)},
         "intervals": {k: d["intervals"][k] for k, d in zip(keys, docs, strict=True)},
+        **(
+            {"prediction": {k: d["prediction"][k] for k, d in zip(keys, docs, strict=True)}}
+            if "prediction" in docs[0]
+            else {}
+        ),
         "complies": all(bool(d["complies"]) for d in docs),
         "warnings": [f"{k}: {w}" for k, d in zip(keys, docs, strict=True) for w in d["warnings"]],
     }
@@ -287,6 +337,8 @@ def _figures(result: dict[str, Any]) -> dict[str, bytes | str]:
         "band-rms-time": iv.band_limited.plot(),
         "interval-stats": iv.stats.plot(),
     }
+    if "overlay" in result:
+        figs["prediction-overlay"] = result["overlay"].plot()
     return {f"{s}-{k}.png": png_bytes(f) for k, f in figs.items()}
 
 
@@ -328,6 +380,16 @@ def _summary(result: dict[str, Any]) -> None:
             f"  integrated acceleration (PIMS, {pb.n_blocks} blocks of {pb.window_s:g} s): "
             f"max {num(worst)} micro-g s"
         )
+    ov = result.get("overlay")
+    if ov is not None:
+        i = ov.worst_ratio_band
+        worst = (
+            "no band resolved by both"
+            if i is None
+            else f"measured/predicted band RMS (worst axis) up to {num(ov.ratio[i])} at "
+            f"{num(ov.center_hz[i])} Hz ({int(ov.judged.sum())} bands compared)"
+        )
+        click.echo(f"  prediction {ov.predicted_path} at {ov.point}: {worst}")
     click.echo("  verdict per criterion:")
     for c in a.criteria:
         click.echo(f"    {c.line()}")

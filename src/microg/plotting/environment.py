@@ -25,6 +25,7 @@ from microg.units import G0
 
 if TYPE_CHECKING:
     from microg.environment.metrics import IntegratedAcceleration, IntegratedBlocks
+    from microg.environment.overlay import BandOverlay
     from microg.environment.requirements import Requirement
 
 __all__ = [
@@ -37,6 +38,7 @@ __all__ = [
     "plot_integrated",
     "plot_integrated_acceleration",
     "plot_overlay",
+    "plot_band_overlay",
 ]
 
 
@@ -279,4 +281,51 @@ def plot_overlay(
     ax2.set_ylabel("PSD [g^2/Hz]")
     ax2.grid(True, which="both", alpha=0.3)
     ax2.legend(fontsize=8)
+    return fig
+
+
+def plot_band_overlay(overlay: BandOverlay, *, title: str = "", ax: Axes | None = None) -> Figure:
+    """A prediction's and a measurement's band RMS (worst axis) against the limit's steps.
+
+    In micro-g, on the band centres: circles and a solid line for the prediction, squares and
+    a dashed line for the measurement; hollow markers where that side does not resolve the band
+    (it is not compared there).  Returns the Figure.
+
+    Parameters
+    ----------
+    overlay : BandOverlay
+        The paired bands (:func:`microg.environment.overlay.band_overlay`).
+    title : str
+        Figure title (default: the point, the sensor and the requirement).
+    ax : matplotlib.axes.Axes, optional
+        Where to draw (default: a new figure).
+    """
+    fig, ax = _figure(
+        ax,
+        title
+        or f"prediction at {overlay.point} and measurement {overlay.sensor} vs "
+        f"{overlay.requirement}",
+    )
+    f = overlay.center_hz
+    # three decades below the lowest limit: what lies lower is far inside it (and a tone-free
+    # band of a clean signal is rounding noise, not a level to draw)
+    floor = float(np.min(overlay.limit_g, initial=np.inf)) * 1e6 * 1e-3
+    floor = floor if np.isfinite(floor) and floor > 0 else 1e-12
+    for y_g, res, style, label in (
+        (overlay.predicted_g, overlay.predicted_resolved, "o-", "prediction"),
+        (overlay.measured_g, overlay.measured_resolved, "s--", "measurement"),
+    ):
+        y = np.maximum(np.asarray(y_g, float) * 1e6, floor)
+        r = np.asarray(res, bool)
+        (ln,) = ax.plot(f, y, style[1:], lw=0.9, label=f"{label} (worst axis)")
+        c = ln.get_color()
+        if np.any(r):
+            ax.plot(f[r], y[r], style[0], ms=4, color=c, label="_resolved")
+        if np.any(~r):
+            ax.plot(f[~r], y[~r], style[0], ms=4, mfc="none", color=c, label="_unresolved")
+    _limit_on(ax, overlay.lower_hz, overlay.upper_hz, overlay.limit_g)
+    _band_axes(ax)
+    ax.set_ylim(bottom=floor)
+    ax.set_ylabel(f"band RMS [micro-g] (floor {floor:.2g})")
+    ax.set_xlabel("frequency [Hz] (hollow: band not resolved, not compared)")
     return fig

@@ -58,6 +58,7 @@ def render_assessment(payload: dict[str, Any], figs: dict[str, dict[str, bytes]]
                 "name": key,
                 "data": obs,
                 "criteria": rows,
+                "overlay": (d.get("prediction") or {}).get(key),
                 "figs": [png_data_uri(b) for b in figs.get(key, {}).values()],
             }
         )
