@@ -51,3 +51,20 @@ def test_each_point_lists_its_verdict_per_criterion() -> None:
     assert "undecided" in section and "reported only" in section
     status = r.observations["lab"].isolation.status
     assert f"<b>Isolation</b> ({status}):" in page
+
+
+def test_the_fitted_mass_note_lists_as_many_items_as_it_counts(sources_page: str) -> None:
+    # the IOC model's port and starboard arrays share names: the note's count and its list
+    # agree (each name with how many items carry it)
+    model = microg.load_model("ioc")
+    fitted = [pm.name for pm in model.all_masses() if pm.fitted]
+    note = next(n for n in microg.analyze("ioc", sources="example", observe=["lab"]).notes
+                if "mass items" in n)  # fmt: skip
+    listed = note.split("model file: ", 1)[1].split(");", 1)[0]
+    assert len(fitted) > len(set(fitted))  # the case in point: shared names
+    for name in set(fitted):
+        k = fitted.count(name)
+        counted = re.findall(re.escape(name) + r" \((\d+) items\)", listed)
+        assert counted == ([str(k)] if k > 1 else []) and name in listed, name
+    assert note.startswith(f"{len(fitted)} mass items")
+    assert listed in sources_page

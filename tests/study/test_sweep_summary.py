@@ -113,3 +113,50 @@ def test_summary_to_xarray_and_plot(result) -> None:
     assert hx.margin.attrs["units"] == "1" and hx.attrs["cases"] == s.cases
     assert list(hx.observe.values) == [str(o) for o in ref.observe.values]
     assert isinstance(s.plot(), Figure)
+
+
+def test_heatmap_colours_the_margin_on_a_labelled_log_scale_with_the_limit_line(result) -> None:
+    from matplotlib.colors import LogNorm
+
+    from microg.plotting.common import png_bytes
+    from microg.plotting.study import heatmap_figure
+
+    s = result.summary(heatmap=("at", "observe"))
+    fig = heatmap_figure(s)
+    ax = fig.axes[0]
+    im = ax.images[0]
+    m = np.asarray(s.heatmap, float)
+    # the image holds the margins themselves (not their log10), on a log norm centred on 1
+    assert isinstance(im.norm, LogNorm)
+    assert im.norm.vmin * im.norm.vmax == pytest.approx(1.0, rel=1e-12)
+    shown = np.ma.filled(im.get_array(), np.nan)
+    ok = np.isfinite(m)
+    np.testing.assert_allclose(
+        shown[ok], np.clip(m[ok], im.norm.vmin, im.norm.vmax), rtol=0, atol=0
+    )
+    assert "margin" in fig.axes[1].get_ylabel() and "log" in fig.axes[1].get_ylabel()
+    # the margin-1 line: one unit segment per pair of neighbouring cells on either side of 1
+    fail, good = ok & (m < 1), ok & (m >= 1)
+    pairs = int(np.sum(fail[:, :-1] & good[:, 1:] | good[:, :-1] & fail[:, 1:]))
+    pairs += int(np.sum(fail[:-1] & good[1:] | good[:-1] & fail[1:]))
+    assert fail.any() and good.any() and pairs > 0  # the study has both sides
+    lines = [c for c in ax.collections if c.get_label() == "margin 1"]
+    assert len(lines) == 1 and len(lines[0].get_segments()) == pairs
+    assert png_bytes(fig)[:4] == b"\x89PNG"
+
+
+def test_sweep_page_says_each_thing_once(result) -> None:
+    import re
+
+    from microg.report.study import figures, render_sweep
+
+    s = result.summary()
+    page = render_sweep(s, figures(s))
+    notes = [re.sub(r"\s+", " ", re.sub(r"<[^>]+>", "", p)).strip()
+             for p in re.findall(r'<p class="note">(.*?)</p>', page, flags=re.S)]  # fmt: skip
+    sentences = [x.strip() for n in notes for x in re.split(r"(?<=\.)\s", n) if x.strip()]
+    assert len(sentences) == len(set(sentences))
+    # the heat map's caption adds what its title does not say: the scale and the limit line
+    cap = next(n for n in notes if "--heatmap" in n)
+    assert "log scale of the margin" in cap and "black line" in cap
+    assert "worst margin over every other axis" not in cap  # the figure's title says it

@@ -8,6 +8,7 @@ vibratory sources, and returns one :class:`~microg.analysis.result.Analysis`.
 
 from __future__ import annotations
 
+from collections import Counter
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
@@ -356,9 +357,15 @@ def _notes(model: Any, opts: AnalysisOptions, obs: Mapping[str, Observation]) ->
     masses = getattr(model, "all_masses", None)
     fitted = [pm.name for pm in masses() if pm.fitted] if callable(masses) else []
     if fitted:
+        # one entry per name, with how many items carry it: the count and the list agree
+        count = Counter(fitted)
+        listed = ", ".join(
+            name if count[name] == 1 else f"{name} ({count[name]} items)"
+            for name in sorted(count)
+        )
         notes.append(
             f"{len(fitted)} mass items of model {getattr(model, 'name', '')!r} carry fitted "
-            f"values (marked fitted = true in the model file: {', '.join(sorted(set(fitted)))}); "
+            f"values (marked fitted = true in the model file: {listed}); "
             "for the shipped IOC models these were fitted to the seed report's Appendix C "
             "because the OCR lost them, so local results near them (the keel) inherit that "
             "uncertainty"

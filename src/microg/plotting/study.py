@@ -12,7 +12,6 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from matplotlib.axes import Axes
-from matplotlib.colors import TwoSlopeNorm
 from matplotlib.figure import Figure
 
 from microg.plotting.common import figure_axes, figure_grid
@@ -37,37 +36,64 @@ def _ticks(ax: Any, n: int, labels: Sequence[object], axis: str) -> None:
 
 
 def heatmap_figure(summary: Summary, *, ax: Axes | None = None) -> Figure:
-    """Worst margin (log10 of limit / band RMS, min over the other axes) over two axes.
+    """Worst margin (limit / band RMS, min over the other axes) over two axes.
 
-    Below 0 (red) some case does not comply; NaN cells (grey) were not computed.
+    The colour scale is logarithmic in the margin itself (the colour bar reads margins, 1 at
+    its middle: a margin of 0.1 is as far below as 10 is above), the cells are labelled with
+    their margin, and the 1.0 contour (the limit) is drawn between the cells that fail and
+    those that comply.  Red: some case does not comply; grey (NaN): not computed.
     """
+    from matplotlib.colors import LogNorm
+
     d1, d2 = summary.heatmap_dims
     lab1, lab2 = summary.heatmap_labels
     m = np.asarray(summary.heatmap, float)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        v = np.log10(m)
-    finite = v[np.isfinite(v)]
-    span = float(np.max(np.abs(finite))) if finite.size else 1.0
+    finite = m[np.isfinite(m) & (m > 0)]
+    # symmetric in log about 1 (vmin * vmax = 1), so the colour map's middle is the limit
+    span = float(np.max(np.abs(np.log10(finite)))) if finite.size else 1.0
     span = max(span, 1e-3)
-    v = np.clip(v, -span, span)
+    shown = np.clip(m, 10.0**-span, 10.0**span)
     fig, ax = figure_axes(ax, 7.5, max(3.2, 0.9 + 0.22 * len(lab1)))
-    cmap = _cmap()
-    im = ax.imshow(np.ma.masked_invalid(v), cmap=cmap, aspect="auto",
-                   norm=TwoSlopeNorm(0.0, -span, span), interpolation="nearest")  # fmt: skip
+    im = ax.imshow(np.ma.masked_invalid(shown), cmap=_cmap(), aspect="auto",
+                   norm=LogNorm(10.0**-span, 10.0**span), interpolation="nearest")  # fmt: skip
     _ticks(ax, len(lab2), lab2, "x")
     _ticks(ax, len(lab1), lab1, "y")
     ax.set_xlabel(d2)
     ax.set_ylabel(d1)
-    ax.set_title(f"Worst margin over the other axes (log10; < 0 fails {summary.requirement})",
-                 fontsize=9)  # fmt: skip
+    ax.set_title(f"Worst margin over the other axes (below 1 fails {summary.requirement}; "
+                 "black line: margin 1)", fontsize=9)  # fmt: skip
     cb = fig.colorbar(im, ax=ax)
-    cb.set_label("log10(limit / band RMS)")
+    cb.set_label("margin = limit / band RMS (log scale)")
+    cb.ax.axhline(1.0, color="k", lw=1.5)
+    _limit_contour(ax, m)
     if m.size <= 400:
         for i in range(m.shape[0]):
             for j in range(m.shape[1]):
                 if np.isfinite(m[i, j]):
                     ax.text(j, i, f"{m[i, j]:.2g}", ha="center", va="center", fontsize=6)
     return fig
+
+
+def _limit_contour(ax: Any, margin: np.ndarray) -> None:
+    """The margin-1 line: the cell edges between a failing cell and a complying neighbour.
+
+    Drawn on the cell boundaries (not interpolated between cell centres): each cell is one set
+    of cases, and a margin between two cells means nothing.  Its label is ``margin 1``.
+    """
+    fail = np.isfinite(margin) & (margin < 1.0)
+    ok = np.isfinite(margin) & (margin >= 1.0)
+    segs = []
+    n1, n2 = margin.shape
+    for i in range(n1):
+        for j in range(n2):
+            if j + 1 < n2 and (fail[i, j] and ok[i, j + 1] or ok[i, j] and fail[i, j + 1]):
+                segs.append([(j + 0.5, i - 0.5), (j + 0.5, i + 0.5)])
+            if i + 1 < n1 and (fail[i, j] and ok[i + 1, j] or ok[i, j] and fail[i + 1, j]):
+                segs.append([(j - 0.5, i + 0.5), (j + 0.5, i + 0.5)])
+    if segs:
+        from matplotlib.collections import LineCollection
+
+        ax.add_collection(LineCollection(segs, colors="k", linewidths=2.0, label="margin 1"))
 
 
 def _cmap() -> Any:
