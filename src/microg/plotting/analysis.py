@@ -13,7 +13,7 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from microg.errors import InputError
-from microg.plotting.common import envelope, figure_axes, figure_grid, figure_of
+from microg.plotting.common import envelope, figure_axes, figure_grid, figure_of, place_labels
 from microg.units import G0
 
 if TYPE_CHECKING:
@@ -35,6 +35,9 @@ __all__ = [
 #: micro-g per m/s^2
 _UG = 1e6 / G0
 
+#: most components whose roots are looked up (each look-up scans the samples once)
+_MAX_JOINED = 500
+
 
 def sample_displacements(structure: Structure, phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Positions (p, 3) of the structure's samples and their displacements (p, 3, m) for phi."""
@@ -52,7 +55,14 @@ def sample_displacements(structure: Structure, phi: np.ndarray) -> tuple[np.ndar
 
 
 def _groups(structure: Structure, n: int) -> list[np.ndarray]:
-    """Sample indices per component (a beam's nodes, a body's masses), ordered along it."""
+    """Sample indices per component (a beam's nodes, a body's masses), ordered along it.
+
+    Each beam's group starts at its root, the sample where it joins its parent (a beam's own
+    samples begin one element out), so the drawn model is connected: on a frame model the
+    sample on the parent node of the beam's first node (:class:`~microg.structure.fem.
+    FrameTree`), otherwise the nearest sample of another component to either end of the beam.
+    The first component (the root body) is left as it is.
+    """
     s = structure.samples
     labels = getattr(s, "labels", None)
     comp = getattr(s, "component", None)
@@ -62,7 +72,54 @@ def _groups(structure: Structure, n: int) -> list[np.ndarray]:
         keys = np.asarray(comp)
     else:
         return [np.arange(n)]
-    return [np.flatnonzero(keys == k) for k in dict.fromkeys(keys.tolist())]
+    groups = [np.flatnonzero(keys == k) for k in dict.fromkeys(keys.tolist())]
+    pos = np.asarray(getattr(s, "position", np.zeros((0, 3))), float).reshape(-1, 3)
+    if not 2 <= len(groups) <= _MAX_JOINED or pos.shape[0] != n:
+        return groups
+    roots = _tree_roots(structure, groups)
+    out = [groups[0]]
+    for g, root in zip(groups[1:], roots[1:], strict=True):
+        if root is None:
+            root = _nearest_root(pos, g)
+        out.append(g if root is None or root in g else np.r_[root, g])
+    return out
+
+
+def _tree_roots(structure: Structure, groups: list[np.ndarray]) -> list[int | None]:
+    """Per group, the sample on the parent node of its root-most node (frame models), or None."""
+    s = structure.samples
+    tree = getattr(structure, "tree", None)
+    dof = getattr(s, "dof_index", None)
+    offset = getattr(s, "offset", None)
+    if tree is None or dof is None or offset is None:
+        return [None] * len(groups)
+    node = np.asarray(dof, int)[:, 0] // 6  # each node's six coordinates, translations first
+    parent = dict(zip(np.asarray(tree.child, int).tolist(), np.asarray(tree.parent, int).tolist()))
+    on_node = np.linalg.norm(np.asarray(offset, float), axis=1) == 0.0
+    roots: list[int | None] = []
+    for g in groups:
+        mine = set(node[g].tolist())
+        above = [parent[k] for k in mine if k in parent and parent[k] not in mine]
+        hits = np.flatnonzero(on_node & (node == above[0])) if len(above) == 1 else []
+        roots.append(int(hits[0]) if len(hits) else None)
+    return roots
+
+
+def _nearest_root(pos: np.ndarray, g: np.ndarray) -> int | None:
+    """The sample outside ``g`` nearest to either end of the group (ordered along it)."""
+    p = pos[g]
+    axis = int(np.argmax(np.ptp(p, axis=0))) if g.size > 1 else 0
+    order = g[np.argsort(p[:, axis], kind="stable")]
+    others = np.setdiff1d(np.arange(pos.shape[0]), g)
+    if others.size == 0:
+        return None
+    best = None
+    for end in (order[0], order[-1]):
+        d = np.linalg.norm(pos[others] - pos[end], axis=1)
+        k = int(np.argmin(d))
+        if best is None or d[k] < best[0]:
+            best = (float(d[k]), int(others[k]))
+    return None if best is None else best[1]
 
 
 def _draw(ax: Any, pos: np.ndarray, groups: list[np.ndarray], h: int, v: int, **kw: Any) -> None:
@@ -144,6 +201,7 @@ def model_figure(
         fig = figure_of(panels[0])
         elastic = elastic[: len(panels) - 2]
     names = "xyz"
+    labels: dict[int, list[tuple[float, float, str, str]]] = {id(a): [] for a in panels[:2]}
     for a, (h, v) in zip(panels[:2], views, strict=True):
         _draw(a, pos, groups, h, v, color="0.35", lw=1.6, marker=".", ms=3)
         for name, d in force_points.items():
@@ -155,25 +213,11 @@ def model_figure(
                 arrowprops={"arrowstyle": "->", "color": "crimson", "lw": 1.8},
             )
             a.plot(p[h], p[v], "o", color="crimson", ms=6)
-            a.annotate(
-                f"force at {name}",
-                (p[h], p[v]),
-                fontsize=8,
-                color="crimson",
-                xytext=(5, 4),
-                textcoords="offset points",
-            )
+            labels[id(a)].append((p[h], p[v], f"force at {name}", "crimson"))
         for name in observed:
             p = structure.points[name].position
             a.plot(p[h], p[v], "s", color="navy", ms=7, mfc="none", mew=1.5)
-            a.annotate(
-                name,
-                (p[h], p[v]),
-                fontsize=8,
-                color="navy",
-                xytext=(5, -11),
-                textcoords="offset points",
-            )
+            labels[id(a)].append((p[h], p[v], name, "navy"))
         a.set_aspect("equal", adjustable="datalim")
         a.set_xlabel(f"{names[h]} [m]")
         a.set_ylabel(f"{names[v]} [m]")
@@ -193,6 +237,8 @@ def model_figure(
         a.set_title(f"mode {j + 1}: {modes.freq_hz[j]:.3g} Hz ({names[h]}-{names[v]})", fontsize=9)
         a.set_xticks([])
         a.set_yticks([])
+    for a in panels[:2]:  # once the figure is laid out: labels kept apart
+        place_labels(a, labels[id(a)])
     return fig
 
 

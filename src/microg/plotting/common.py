@@ -1,4 +1,4 @@
-"""What every figure module shares: where a figure draws, drawing envelopes, PNG bytes.
+"""What every figure module shares: where a figure draws, envelopes, point labels, PNG bytes.
 
 Figures are ``matplotlib.figure.Figure`` objects built without pyplot, so the caller's
 backend (a notebook's, a GUI's) is never switched and no global figure state is kept.  Every
@@ -30,6 +30,7 @@ __all__ = [
     "figure_axes",
     "figure_grid",
     "figure_of",
+    "place_labels",
     "png_bytes",
 ]
 
@@ -156,3 +157,111 @@ def png_bytes(fig: Figure, dpi: int = 110) -> bytes:
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=dpi)
     return buf.getvalue()
+
+
+#: offsets (points) a point's label tries, nearest first: beside the point, then further above
+#: and below it, to the right and then to the left
+_LABEL_OFFSETS = tuple(
+    (dx, dy) for dy in (4, -4, 15, -15, 26, -26, 37, -37, 48, -48) for dx in (5, -5)
+)
+
+
+def _renderer(fig: Figure) -> Any:
+    """A renderer of ``fig`` to measure text with (an Agg canvas when it has none)."""
+    get = getattr(fig.canvas, "get_renderer", None)
+    if get is None:
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+        get = FigureCanvasAgg(fig).get_renderer
+    return get()
+
+
+def _overlap(a: Any, b: Any) -> float:
+    w = min(a.x1, b.x1) - max(a.x0, b.x0)
+    h = min(a.y1, b.y1) - max(a.y0, b.y0)
+    return max(w, 0.0) * max(h, 0.0)
+
+
+def place_labels(
+    ax: Axes,
+    labels: list[tuple[float, float, str, str]],
+    *,
+    fontsize: float = 8.0,
+    merge_pt: float = 6.0,
+) -> list[Any]:
+    """Label points of ``ax`` so that no two labels overlap; returns the annotations.
+
+    Call it once the rest of the figure is drawn (colour bars, titles): it lays the figure
+    out, merges the labels of points of one colour closer than ``merge_pt`` on the page into
+    one block (one line each), then puts each label at the first offset of
+    ``_LABEL_OFFSETS`` whose box overlaps no text of the axes (or the least overlapping one),
+    and checks once more after the layout settles.
+
+    Parameters
+    ----------
+    ax : the axes
+    labels : (x, y, text, colour) per point, x and y in data coordinates
+    fontsize : points
+    merge_pt : distance on the page (points) under which two points share one label
+    """
+    fig = figure_of(ax)
+    renderer = _renderer(fig)
+    fig.draw_without_rendering()
+    if not labels:
+        return []
+    xy = ax.transData.transform(np.array([(x, y) for x, y, _, _ in labels], float))
+    tol = merge_pt * fig.dpi / 72.0
+    blocks: list[tuple[int, list[str]]] = []  # (index of the anchor label, texts)
+    for i, (_, _, text, colour) in enumerate(labels):
+        for k, texts in blocks:
+            if labels[k][3] == colour and float(np.hypot(*(xy[i] - xy[k]))) <= tol:
+                if text not in texts:
+                    texts.append(text)
+                break
+        else:
+            blocks.append((i, [text]))
+    anns = [
+        ax.annotate(
+            "\n".join(texts),
+            (labels[k][0], labels[k][1]),
+            xytext=_LABEL_OFFSETS[0],
+            textcoords="offset points",
+            fontsize=fontsize,
+            color=labels[k][3],
+            annotation_clip=False,
+        )
+        for k, texts in blocks
+    ]
+    for _ in range(2):
+        mine = {id(a) for a in anns}
+        fixed = [
+            t.get_window_extent(renderer)
+            for t in ax.texts
+            if id(t) not in mine and t.get_text().strip()
+        ]
+        placed: list[Any] = []
+        clash = False
+        for a in anns:
+            best, least = _LABEL_OFFSETS[0], math.inf
+            for dx, dy in _LABEL_OFFSETS:
+                a.xyann = (dx, dy)
+                a.set_horizontalalignment("left" if dx > 0 else "right")
+                a.set_verticalalignment("bottom" if dy > 0 else "top")
+                box = a.get_window_extent(renderer)
+                hit = sum(_overlap(box, o) for o in fixed + placed)
+                if hit < least:
+                    best, least = (dx, dy), hit
+                if hit == 0.0:
+                    break
+            clash = clash or least > 0.0
+            a.xyann = best
+            a.set_horizontalalignment("left" if best[0] > 0 else "right")
+            a.set_verticalalignment("bottom" if best[1] > 0 else "top")
+            placed.append(a.get_window_extent(renderer))
+        fig.draw_without_rendering()
+        boxes = [a.get_window_extent(renderer) for a in anns]
+        if not clash and all(
+            _overlap(p, q) == 0.0 for i, p in enumerate(boxes) for q in boxes[i + 1 :]
+        ):
+            break
+    return anns

@@ -14,7 +14,7 @@ import numpy as np
 from matplotlib.colors import LogNorm
 from matplotlib.figure import Figure
 
-from microg.plotting.common import figure_grid
+from microg.plotting.common import figure_grid, place_labels
 from microg.units import G0
 
 __all__ = ["plot_quasi_steady_map"]
@@ -55,6 +55,7 @@ def plot_quasi_steady_map(result: Any, *, ax: Any = None) -> Figure:
     vmax = float(max(positive.max(initial=limit_ug) * 1.2, 2.0 * limit_ug))
     norm = LogNorm(vmin=vmin, vmax=vmax)
     sc = None
+    labels: dict[int, list[tuple[float, float, str, str]]] = {id(a): [] for a in axes}
     for ax, (i, j), title in zip(
         axes, ((0, 2), (1, 2)), ("side view (x-z)", "front view (y-z)"), strict=True
     ):
@@ -89,12 +90,13 @@ def plot_quasi_steady_map(result: Any, *, ax: Any = None) -> Figure:
                 color="k",
                 linestyle="none",
             )
-            ax.annotate(
-                f"{name}\n{p.peak_magnitude_mps2 / G0 * 1e6:.3g} ug",
-                (p.position_m[i], p.position_m[j]),
-                textcoords="offset points",
-                xytext=(4, 4),
-                fontsize=7,
+            labels[id(ax)].append(
+                (
+                    p.position_m[i],
+                    p.position_m[j],
+                    f"{name} {p.peak_magnitude_mps2 / G0 * 1e6:.3g} ug",
+                    "k",
+                )
             )
         ax.set_xlabel(f"{'xyz'[i]} (m)")
         ax.set_ylabel(f"{'xyz'[j]} (m)")
@@ -110,4 +112,6 @@ def plot_quasi_steady_map(result: Any, *, ax: Any = None) -> Figure:
             f"{result.model}: quasi-steady acceleration, {result.attitude.kind} attitude; "
             f"shaded: within {limit_ug:g} micro-g (contour in the plane through the CM)"
         )
+    for a in axes:  # once the figure is laid out: labels kept apart
+        place_labels(a, labels[id(a)], fontsize=7)
     return fig
