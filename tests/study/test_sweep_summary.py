@@ -160,3 +160,23 @@ def test_sweep_page_says_each_thing_once(result) -> None:
     cap = next(n for n in notes if "--heatmap" in n)
     assert "log scale of the margin" in cap and "black line" in cap
     assert "worst margin over every other axis" not in cap  # the figure's title says it
+
+
+def test_summary_shows_itself_in_a_notebook(result) -> None:
+    import re
+
+    s = result.summary(heatmap=("at", "observe"))
+    page = s._repr_html_()
+    frac = f"{100 * s.complying_fraction:.1f} %"
+    assert f"{s.cases} cases" in page and f"{s.complying} comply with {s.requirement}" in page
+    assert frac in page
+    # one row per observed point: its worst case's margin (to_dict's number) and verdict
+    for name, worst in s.worst.items():
+        m = re.search(rf"<tr><td>{re.escape(name)}</td><td>([^<]*)</td><td>([^<]*)</td>", page)
+        assert m is not None, name
+        assert m.group(1) == f"{worst[0]['margin']:.3g}"
+        assert m.group(2) == ("complies" if worst[0]["complies"] else "does not comply")
+    # the heat map's cells, row by row, are Summary.heatmap's
+    for label, row in zip(s.heatmap_labels[0], np.asarray(s.heatmap, float), strict=True):
+        cells = "".join("<td>-</td>" if np.isnan(v) else f"<td>{v:.3g}</td>" for v in row)
+        assert f"<tr><th>{label}</th>{cells}</tr>" in page

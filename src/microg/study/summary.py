@@ -176,6 +176,64 @@ class Summary:
             },
         )
 
+    def _repr_html_(self) -> str:
+        """The summary in a notebook: the verdict, each point's worst case, the heat map.
+
+        The numbers are :meth:`to_dict`'s (margin = limit / band RMS, below 1 fails); the heat
+        map's cells are its worst margins over every other axis ("-": no case computed).
+        """
+        from html import escape
+
+        def num(v: Any) -> str:
+            if v is None:
+                return "-"
+            if v == "inf":
+                return "inf"
+            f = float(v)
+            return "-" if np.isnan(f) else f"{f:.3g}"
+
+        frac = self.complying_fraction
+        share = "-" if frac is None else f"{100.0 * frac:.1f} %"
+        planned = f" of {self.planned} planned" if self.planned != self.cases else ""
+        head = (
+            f"<p><b>sweep</b>: {self.cases} cases{planned}, {self.complying} comply with "
+            f"{escape(self.requirement)} ({share})</p>"
+        )
+        rows = []
+        for name, worst in self.worst.items():
+            if not worst:
+                continue
+            w = worst[0]
+            case = ", ".join(
+                f"{escape(str(k))}={escape(str(v))}" for k, v in w["case"].items() if k != "observe"
+            )
+            verdict = "complies" if w.get("complies") else "does not comply"
+            rows.append(
+                f"<tr><td>{escape(name)}</td><td>{num(w.get('margin'))}</td>"
+                f"<td>{verdict}</td><td>{case}</td></tr>"
+            )
+        worst_table = (
+            "<table><tr><th>observed point</th><th>worst margin</th><th>verdict</th>"
+            f"<th>its case</th></tr>{''.join(rows)}</table>"
+        )
+        d0, d1 = self.heatmap_dims
+        l0, l1 = self.heatmap_labels
+        cells = "".join(
+            f"<tr><th>{escape(str(a))}</th>"
+            + "".join(f"<td>{num(v)}</td>" for v in np.asarray(self.heatmap, float)[i])
+            + "</tr>"
+            for i, a in enumerate(l0)
+        )
+        heat = (
+            f"<p>worst margin over the other axes, {escape(d0)} (rows) by {escape(d1)}</p>"
+            f"<table><tr><th></th>{''.join(f'<th>{escape(str(b))}</th>' for b in l1)}</tr>"
+            f"{cells}</table>"
+            if len(l0) * len(l1) <= 400
+            else ""
+        )
+        warn = "".join(f"<p>warning: {escape(w)}</p>" for w in self.warnings)
+        return head + worst_table + heat + warn
+
     def plot(self, ax: Any = None) -> Any:
         """The heat map of the worst margins (:func:`microg.plotting.study.heatmap_figure`).
 
