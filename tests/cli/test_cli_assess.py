@@ -341,7 +341,9 @@ def test_bad_predicted(tmp_path: Path, csv_file: Path, prediction: Path, capsys)
     several.write_text(json.dumps(two))
     err = _bad(tmp_path, capsys, [str(csv_file), "--predicted", str(several)], "--observe")
     assert "2 points (lab, crew)" in err
-    rc, out, err = _run(capsys, ["assess", str(csv_file), "--predicted", str(several),
-                                 "--observe", "crew", "--json"])
+    rc, out, err = _run(
+        capsys,
+        ["assess", str(csv_file), "--predicted", str(several), "--observe", "crew", "--json"],
+    )
     assert rc == 0 and json.loads(out)["prediction"]["sensor"]["point"] == "crew"
     _bad(tmp_path, capsys, [str(csv_file), "--observe", "lab"], "--observe")

@@ -360,8 +360,7 @@ def _notes(model: Any, opts: AnalysisOptions, obs: Mapping[str, Observation]) ->
         # one entry per name, with how many items carry it: the count and the list agree
         count = Counter(fitted)
         listed = ", ".join(
-            name if count[name] == 1 else f"{name} ({count[name]} items)"
-            for name in sorted(count)
+            name if count[name] == 1 else f"{name} ({count[name]} items)" for name in sorted(count)
         )
         notes.append(
             f"{len(fitted)} mass items of model {getattr(model, 'name', '')!r} carry fitted "

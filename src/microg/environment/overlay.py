@@ -62,8 +62,12 @@ def read_prediction(path: str | Path, *, where: str = "predicted") -> dict[str, 
             fix="give the results.json of `microg analyze`",
         )
     obs = data.get("observations")
-    if not isinstance(obs, dict) or not obs or not all(
-        isinstance(o, dict) and isinstance(o.get("third_octave"), dict) for o in obs.values()
+    if (
+        not isinstance(obs, dict)
+        or not obs
+        or not all(
+            isinstance(o, dict) and isinstance(o.get("third_octave"), dict) for o in obs.values()
+        )
     ):
         raise InputError(
             f"{p} is a microg result without band results at observed points",
@@ -75,9 +79,7 @@ def read_prediction(path: str | Path, *, where: str = "predicted") -> dict[str, 
 
 def _floats(values: Any) -> np.ndarray:
     """JSON numbers (``"inf"``/None allowed) as floats."""
-    return np.array(
-        [math.nan if v is None else float(v) for v in values], dtype=float
-    )
+    return np.array([math.nan if v is None else float(v) for v in values], dtype=float)
 
 
 def _choose_point(pred: dict[str, Any], point: str | None, sensor: str) -> str:
@@ -128,9 +130,7 @@ class BandOverlay:
     def ratio(self) -> np.ndarray:
         """Measured over predicted band RMS, (nb,); inf where the prediction is 0."""
         with np.errstate(divide="ignore", invalid="ignore"):
-            return np.where(
-                self.predicted_g > 0, self.measured_g / self.predicted_g, np.inf
-            )
+            return np.where(self.predicted_g > 0, self.measured_g / self.predicted_g, np.inf)
 
     @property
     def judged(self) -> np.ndarray:
@@ -236,9 +236,7 @@ def band_overlay(
             f"the prediction's bands at {name!r} are incomplete", where="predicted"
         ) from None
     if not (rms.shape == centre.shape == resolved.shape == limit.shape):
-        raise InputError(
-            f"the prediction's bands at {name!r} are incomplete", where="predicted"
-        )
+        raise InputError(f"the prediction's bands at {name!r} are incomplete", where="predicted")
     # the band tables run to each record's Nyquist frequency: compare the bands both have
     pi, mi = [], []
     for k, c in enumerate(m.center_hz):
@@ -247,9 +245,7 @@ def band_overlay(
             pi.append(int(hit[0]))
             mi.append(k)
     p_idx, m_idx = np.array(pi, int), np.array(mi, int)
-    if p_idx.size == 0 or not np.allclose(
-        limit[p_idx], m.limit_g[m_idx], rtol=_SAME_REL, atol=0.0
-    ):
+    if p_idx.size == 0 or not np.allclose(limit[p_idx], m.limit_g[m_idx], rtol=_SAME_REL, atol=0.0):
         raise InputError(
             f"the prediction's bands at {name!r} are not the measurement's under requirement "
             f"{req!r} (another band table or limits)",

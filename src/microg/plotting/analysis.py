@@ -94,14 +94,15 @@ def _tree_roots(structure: Structure, groups: list[np.ndarray]) -> list[int | No
     if tree is None or dof is None or offset is None:
         return [None] * len(groups)
     node = np.asarray(dof, int)[:, 0] // 6  # each node's six coordinates, translations first
-    parent = dict(zip(np.asarray(tree.child, int).tolist(), np.asarray(tree.parent, int).tolist()))
+    child = np.asarray(tree.child, int).tolist()
+    parent = dict(zip(child, np.asarray(tree.parent, int).tolist(), strict=True))
     on_node = np.linalg.norm(np.asarray(offset, float), axis=1) == 0.0
     roots: list[int | None] = []
     for g in groups:
         mine = set(node[g].tolist())
         above = [parent[k] for k in mine if k in parent and parent[k] not in mine]
-        hits = np.flatnonzero(on_node & (node == above[0])) if len(above) == 1 else []
-        roots.append(int(hits[0]) if len(hits) else None)
+        hits = np.flatnonzero(on_node & (node == above[0])) if len(above) == 1 else np.zeros(0)
+        roots.append(int(hits[0]) if hits.size else None)
     return roots
 
 
