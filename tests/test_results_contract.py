@@ -454,6 +454,7 @@ CONTRACT: dict[str, tuple[str, ...]] = {
     "microg.dynamics.frequency.HarmonicResponse": ("to_dict", "to_xarray", "plot"),
     "microg.dynamics.frequency.BandResponse": ("to_dict", "to_xarray", "plot"),
     "microg.dynamics.modes.Modes": ("to_dict", "to_xarray", "plot"),
+    "microg.environment.overlay.BandOverlay": ("to_dict", "to_xarray", "plot"),
     # study
     "microg.study.run.SweepResult": ("to_dict", "to_xarray", "plot"),
 }
