@@ -70,3 +70,29 @@ def test_each_modal_group_is_computed_once_whatever_the_tasks(monkeypatch) -> No
     assert len(calls) == n_groups and split.computed_blocks == 8 * n_groups
     for v in ("peak_accel_g", "band_rms_g", "margin", "complies"):
         assert (split.dataset[v].values == whole[v].values).all(), v
+
+
+def test_a_scatter_that_never_answers_is_abandoned_and_tried_again(monkeypatch) -> None:
+    # distributed's scatter(timeout=) did not bound a scatter racing a worker's death (a CI
+    # run waited 10 minutes in Client.scatter): each attempt is now bounded by wall time
+    import threading
+    import time
+
+    from microg.study import run
+
+    monkeypatch.setattr(run, "SCATTER_TIMEOUT_S", 0.2)
+    never = threading.Event()
+    calls = []
+
+    class Client:
+        def scatter(self, data, **kw):
+            calls.append(kw)
+            if len(calls) == 1:
+                never.wait()  # the first attempt hangs for good
+            return f"future of {data}"
+
+    t0 = time.perf_counter()
+    assert run._scatter(Client(), "basis", True) == "future of basis"
+    assert len(calls) == 2 and calls[1]["broadcast"] is True
+    assert time.perf_counter() - t0 < 5.0
+    never.set()

@@ -493,13 +493,36 @@ def _lost(exc: BaseException) -> bool:
 def _scatter(client: Any, data: Any, broadcast: bool) -> Any:
     """``client.scatter``, again after a moment if a worker is leaving (a restart is racing).
 
-    Each attempt is bounded (:data:`SCATTER_TIMEOUT_S`; a timeout is an OSError).
+    Each attempt is bounded by :data:`SCATTER_TIMEOUT_S` of wall time: distributed's own
+    ``timeout`` does not bound a scatter that raced a worker's death (it waited without end
+    in CI), so the call runs in a daemon thread that is abandoned when it does not answer.
     """
+    import threading
     import time
+
+    def attempt_once() -> Any:
+        box: dict[str, Any] = {}
+
+        def run() -> None:
+            try:
+                box["value"] = client.scatter(
+                    data, broadcast=broadcast, hash=False, timeout=SCATTER_TIMEOUT_S
+                )
+            except BaseException as exc:  # handed to the caller's thread
+                box["error"] = exc
+
+        worker = threading.Thread(target=run, name="microg-scatter", daemon=True)
+        worker.start()
+        worker.join(SCATTER_TIMEOUT_S)
+        if worker.is_alive():
+            raise TimeoutError(f"scatter did not answer in {SCATTER_TIMEOUT_S:g} s")
+        if "error" in box:
+            raise box["error"]
+        return box["value"]
 
     for attempt in range(5):
         try:
-            return client.scatter(data, broadcast=broadcast, hash=False, timeout=SCATTER_TIMEOUT_S)
+            return attempt_once()
         except (KeyError, OSError):
             if attempt == 4:
                 raise
