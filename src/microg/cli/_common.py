@@ -19,7 +19,10 @@ from typing import Any
 import click
 from click.core import ParameterSource
 
+from microg import defaults
+from microg.cli.params import Integer
 from microg.defaults import PRESETS, preset
+from microg.structure.ritz import MAX_FUNCTIONS
 
 __all__ = ["CONTEXT_SETTINGS", "Option", "given", "num", "preset_option", "written"]
 
@@ -98,3 +101,23 @@ def preset_option(params: Mapping[str, str]) -> Callable[[Any], Any]:
         callback=apply,
         help=f"Named settings, used as this command's defaults (given options win). {shown}.",
     )
+
+
+#: the most frame elements per beam any command accepts
+MAX_ELEMENTS = 10000
+
+
+def discretisation_options(command: Callable[..., Any]) -> Callable[..., Any]:
+    """``--functions`` (Ritz) and ``--elements`` (FE), the same in every command."""
+    command = click.option(
+        "--elements",
+        type=Integer(1, MAX_ELEMENTS),
+        default=defaults.ELEMENTS,
+        help="--method fem: elements per beam (more where masses and joints cut a beam).",
+    )(command)
+    return click.option(
+        "--functions",
+        type=Integer(1, MAX_FUNCTIONS),
+        default=defaults.FUNCTIONS,
+        help="--method ritz: admissible functions per beam and deformation kind.",
+    )(command)

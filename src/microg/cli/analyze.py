@@ -16,10 +16,9 @@ import click
 
 from microg import defaults
 from microg.analysis import DEFAULTS
-from microg.cli._common import Option, given, preset_option, written
+from microg.cli._common import Option, discretisation_options, given, preset_option, written
 from microg.cli._errors import flag_errors
 from microg.cli.params import Integer, Number, PathType, PositiveFloat
-from microg.structure.ritz import MAX_FUNCTIONS
 from microg.units import LB
 
 __all__ = ["analyze", "flag_errors", "write_outputs"]
@@ -128,18 +127,7 @@ PRESET_PARAMS = {k: k for k in ("method", "plane", "damping", "functions")}
     default=DEFAULTS["plane"],
     help="--method ritz: the 3-D assumed-modes model, or the report's planar model.",
 )
-@click.option(
-    "--functions",
-    type=Integer(1, MAX_FUNCTIONS),
-    default=defaults.FUNCTIONS,
-    help="--method ritz: admissible functions per beam and deformation kind.",
-)
-@click.option(
-    "--elements",
-    type=Integer(1, 10000),
-    default=defaults.ELEMENTS,
-    help="--method fem: elements per beam (more where masses and joints cut a beam).",
-)
+@discretisation_options
 @click.option(
     "--n-modes",
     type=Integer(1, 2000),

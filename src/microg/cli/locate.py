@@ -22,7 +22,7 @@ import numpy as np
 
 from microg import defaults
 from microg._io import dumps
-from microg.cli._common import Option, given, num, preset_option, written
+from microg.cli._common import Option, discretisation_options, given, num, preset_option, written
 from microg.cli.params import Integer, Number, PathType, PositiveFloat
 from microg.errors import InputError
 from microg.location.amap import DEFAULTS as LOCATE_DEFAULTS
@@ -228,18 +228,7 @@ def _unit_system(station: Any, model: str) -> str | None:
     help="--method ritz: the 3-D assumed-modes model, or the report's planar model; otherwise "
     "it sets the default direction only.",
 )
-@click.option(
-    "--functions",
-    type=Integer(1, MAX_FUNCTIONS),
-    default=defaults.FUNCTIONS,
-    help="--method ritz: admissible functions per beam and deformation kind.",
-)
-@click.option(
-    "--elements",
-    type=Integer(1, 2000),
-    default=defaults.ELEMENTS,
-    help="--method fem: elements per beam.",
-)
+@discretisation_options
 @click.option(
     "--n-modes",
     "n_modes",

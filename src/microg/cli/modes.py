@@ -13,9 +13,8 @@ from typing import Any
 import click
 
 from microg import defaults
-from microg.cli._common import Option, given, num, preset_option, written
+from microg.cli._common import Option, discretisation_options, given, num, preset_option, written
 from microg.cli.params import Integer, PathType, PositiveFloat
-from microg.structure.ritz import MAX_FUNCTIONS
 
 __all__ = ["modes"]
 
@@ -58,18 +57,7 @@ def _effective_percent(m: Any) -> dict[str, Any]:
     help="Ritz: the report's planar model in this plane, or the 3-D assumed-modes model. "
     "FE: report only the modes with more than half their kinetic energy in this plane.",
 )
-@click.option(
-    "--functions",
-    type=Integer(1, MAX_FUNCTIONS),
-    default=defaults.FUNCTIONS,
-    help="--method ritz: admissible functions per beam and deformation kind.",
-)
-@click.option(
-    "--elements",
-    type=Integer(1, 10000),
-    default=defaults.ELEMENTS,
-    help="--method fem: minimum elements per beam (more where masses and joints cut it).",
-)
+@discretisation_options
 @click.option(
     "--n-modes",
     "n_modes",
