@@ -20,9 +20,7 @@ import click
 from click.core import ParameterSource
 
 from microg import defaults
-from microg.cli.params import Integer
 from microg.defaults import PRESETS, preset
-from microg.structure.ritz import MAX_FUNCTIONS
 
 __all__ = ["CONTEXT_SETTINGS", "Option", "given", "num", "preset_option", "written"]
 
@@ -108,7 +106,14 @@ MAX_ELEMENTS = 10000
 
 
 def discretisation_options(command: Callable[..., Any]) -> Callable[..., Any]:
-    """``--functions`` (Ritz) and ``--elements`` (FE), the same in every command."""
+    """``--functions`` (Ritz) and ``--elements`` (FE), the same in every command.
+
+    Imported when a command's module loads, not with ``microg.cli`` (numpy must not load before
+    :func:`microg.cli.one_blas_thread`).
+    """
+    from microg.cli.params import Integer
+    from microg.structure.ritz import MAX_FUNCTIONS
+
     command = click.option(
         "--elements",
         type=Integer(1, MAX_ELEMENTS),
