@@ -33,6 +33,7 @@ __all__ = [
     "CREW_T13_S",
     "CREW_T14_S",
     "LAYOUT_METHOD",
+    "NASTRAN_COUPLED_MASS",
     "PRESETS",
     "preset",
 ]
@@ -69,6 +70,9 @@ CREW_T1_S = 1.0
 CREW_T13_S = 13.0
 #: end of the landing, s (Eq. 2.16)
 CREW_T14_S = 14.0
+#: NASTRAN's coupled CBAR mass (a deck with PARAM,COUPMASS > 0) as current NASTRAN forms it:
+#: "coupled" (Simcenter Nastran 2020.2); "coupled-nx9" is NX Nastran 9.1's (2014)
+NASTRAN_COUPLED_MASS = "coupled"
 #: the layout optimiser's discretisation: each trial layout's assumed-modes model is
 #: re-assembled incrementally (a frame model would be re-meshed and re-solved, seconds each)
 LAYOUT_METHOD = "ritz"

@@ -255,10 +255,14 @@ def test_rigid_elements_and_constraints(tmp_path):
             load_bdf(_deck(tmp_path, t2, "bad.bdf"), units="m, N, s")
 
 
-def test_coupmass_selects_consistent_mass(tmp_path):
-    assert load_bdf(_deck(tmp_path, BASE), units="m, N, s").mass_formulation == "lumped"
-    g = load_bdf(_deck(tmp_path, BASE + "PARAM,COUPMASS,1\n", "c.bdf"), units="m, N, s")
-    assert g.mass_formulation == "consistent"
+def test_coupmass_selects_coupled_mass(tmp_path):
+    g = load_bdf(_deck(tmp_path, BASE), units="m, N, s", coupled_mass="coupled-nx9")
+    assert g.mass_formulation == "lumped"  # no COUPMASS: lumped whatever coupled_mass says
+    assert g.meta["mass_formulation_note"].startswith("lumped (no PARAM,COUPMASS > 0")
+    deck = _deck(tmp_path, BASE + "PARAM,COUPMASS,1\n", "c.bdf")
+    assert load_bdf(deck, units="m, N, s").mass_formulation == "coupled"  # current Simcenter
+    for form in ("coupled-nx9", "consistent"):
+        assert load_bdf(deck, units="m, N, s", coupled_mass=form).mass_formulation == form
 
 
 def test_fixture_deck_cards_and_ignored_ones():

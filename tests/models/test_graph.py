@@ -205,7 +205,11 @@ def test_dump_and_reload_reproduce_the_model():
         ),
         (('axes = "basic"\n', ""), "spring[0]", "coordinate system"),
         (("xy = 0.1", "xy = 3"), "payload", "positive semidefinite"),
-        (('mass = "consistent"', 'mass = "diagonal"'), "graph.mass", "'lumped' or 'consistent'"),
+        (
+            ('mass = "consistent"', 'mass = "diagonal"'),
+            "graph.mass",
+            "'lumped', 'consistent', 'coupled' or",
+        ),
         # the structure (pydantic, as for station files): tables, kinds of value, counts
         (("[[rod]]", "[[bogus]]\n[[rod]]"), "frame.toml: bogus", "unknown key"),
         (('nodes = ["c", "a"]', 'nodes = ["c"]'), "rod[0].nodes", "expected two node names"),

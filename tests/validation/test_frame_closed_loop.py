@@ -7,9 +7,9 @@ with :func:`microg.models.bdf.load_bdf` and solved free-free with microg's frame
 
 The reference is a plain dense assembly written here from the textbook element matrices
 (Przemieniecki, *Theory of Matrix Structural Analysis*: Eq. 5.115 beam stiffness, Eq. 11.42
-consistent mass; rod ``EA/L``; the CONM2 rigid-body mass; the CBUSH ``[[k, -k], [-k, k]]``),
-solved in the deck's own units by scipy (QZ on the singular lumped-mass pencil, ``eigh``
-for the consistent one).  It shares no code with microg's kernels, assembler, link
+consistent mass in NASTRAN's coupled CBAR form under COUPMASS; rod ``EA/L``; the CONM2
+rigid-body mass; the CBUSH ``[[k, -k], [-k, k]]``), solved in the deck's own units by scipy
+(QZ on the singular lumped-mass pencil, ``eigh`` for the coupled one).  It shares no code with microg's kernels, assembler, link
 elimination or condensation.
 """
 
@@ -118,14 +118,17 @@ def _beam_k(L, A, I1, I2, J):
     return k
 
 
-def _beam_m_consistent(L, m, polar):
-    """Przemieniecki Eq. 11.42 without rotary inertia, torsion rho J L / 6 [[2, 1], [1, 2]]."""
+def _beam_m_coupled(L, m):
+    """NASTRAN's coupled CBAR mass as Simcenter Nastran 2020.2 forms it (the deck's COUPMASS).
+
+    Przemieniecki Eq. 11.42 without rotary inertia, no torsional inertia, and without the
+    coupling of the two ends' bending rotations (``-3 L^2 m L / 420``): the form fitted to
+    that release's runs in ``test_nastran_bar_mass.py``.
+    """
     M = np.zeros((12, 12))
     for a, b in ((0, 6),):
         M[a, a] = M[b, b] = m * L / 3
         M[a, b] = M[b, a] = m * L / 6
-    M[3, 3] = M[9, 9] = polar * L / 3
-    M[3, 9] = M[9, 3] = polar * L / 6
     c = m * L / 420
     for (v, t, v2, t2), s in (((1, 5, 7, 11), 1.0), ((2, 4, 8, 10), -1.0)):
         M[v, v] = M[v2, v2] = 156 * c
@@ -135,7 +138,6 @@ def _beam_m_consistent(L, m, polar):
         M[v, t2] = M[t2, v] = -s * 13 * L * c
         M[v2, t] = M[t, v2] = s * 13 * L * c
         M[t, t] = M[t2, t2] = 4 * L**2 * c
-        M[t, t2] = M[t2, t] = -3 * L**2 * c
     return M
 
 
@@ -166,7 +168,7 @@ def reference(coupmass: bool) -> np.ndarray:
         ke = Tm.T @ _beam_k(L, **BAR) @ Tm
         mpl = RHO * BAR["A"]
         if coupmass:
-            me = Tm.T @ _beam_m_consistent(L, mpl, RHO * (BAR["I1"] + BAR["I2"])) @ Tm
+            me = Tm.T @ _beam_m_coupled(L, mpl) @ Tm
         else:  # NASTRAN CBAR lumped: half the mass on each end's translations
             me = np.diag(np.r_[[mpl * L / 2] * 3, [0.0] * 3, [mpl * L / 2] * 3, [0.0] * 3])
         d12 = np.r_[dofs(a), dofs(b)]
@@ -209,7 +211,7 @@ def reference(coupmass: bool) -> np.ndarray:
 def test_closed_loop_truss_matches_dense_reference(tmp_path, coupmass):
     deck = write_deck(tmp_path / "truss.bdf", coupmass)
     graph = load_bdf(deck, units="mm, N, s")
-    assert graph.mass_formulation == ("consistent" if coupmass else "lumped")
+    assert graph.mass_formulation == ("coupled" if coupmass else "lumped")
     assert len(graph.beams) == 12 and len(graph.rods) == 5 and len(graph.springs) == 1
     structure = build_frame(graph)
     modes = solve_modes(structure, structure.n_dof)  # all modes

@@ -27,7 +27,10 @@ the mass unit is FORCE TIME^2 / LENGTH.  Mass input (densities, non-structural m
 is multiplied by WTMASS (``PARAM,WTMASS``, or the ``wtmass`` argument; both given and
 different is an error).
 
-**Element formulation** follows NASTRAN: lumped mass unless ``PARAM,COUPMASS`` > 0; shear
+**Element formulation** follows NASTRAN: lumped mass unless ``PARAM,COUPMASS`` > 0, then
+NASTRAN's coupled CBAR mass as Simcenter Nastran 2020.2 forms it (``coupled_mass="coupled"``,
+the default) or NX Nastran 9.1 (``"coupled-nx9"``), stated in ``meta["mass_formulation_note"]``;
+shear
 flexibility from PBAR/PBEAM K1, K2 (PBAR blank: none; PBEAM default 1.0; 0.0: none) and from
 the PBARL/PBEAML section (:data:`~microg.models.bdf_properties.SECTION_SHEAR_FACTORS`);
 see :mod:`microg.structure.elements`.
@@ -45,6 +48,7 @@ from typing import Any
 
 import numpy as np
 
+from microg import defaults
 from microg.errors import InputError
 from microg.models.bdf_cards import MAX_CARDS, MAX_INCLUDE_DEPTH, Card, read_cards
 from microg.models.bdf_properties import (
@@ -73,6 +77,8 @@ from microg.models.graph_model import (
     BeamSection,
     ConcentratedMass,
     Constraint,
+    MASS_NOTES,
+    NASTRAN_COUPLED_FORMS,
     GraphModel,
     GraphPoint,
     Interpolation,
@@ -174,6 +180,7 @@ class _Deck:
         self.grid_cards: dict[int, Card] = {}
         self.grid_ps: list[tuple[str, str]] = []
         self.spc_sets: list[int] = []
+        self.coupled_form = defaults.NASTRAN_COUPLED_MASS
 
     def by_id(self, names: tuple[str, ...], what: str) -> dict[int, Card]:
         out: dict[int, Card] = {}
@@ -227,6 +234,12 @@ class _Deck:
             and isinstance(coupmass.raw(2), int | float)
             and coupmass.raw(2) > 0
         )
+        formulation = "lumped" if lumped else self.coupled_form
+        chosen_by = (
+            "no PARAM,COUPMASS > 0 in the deck: NASTRAN's default"
+            if lumped
+            else f"PARAM,COUPMASS,{coupmass.raw(2) if coupmass else ''} in the deck"
+        )
         if "K6ROT" in params:
             self.warnings.append(
                 "PARAM K6ROT noted: it stiffens shell drilling rotations only; no shells here"
@@ -251,7 +264,8 @@ class _Deck:
             "format": "nastran-bdf",
             "units": {"length_m": self.sc.length, "force_N": self.sc.force, "time_s": self.sc.time},
             "wtmass": wt,
-            "mass_formulation": "lumped" if lumped else "consistent",
+            "mass_formulation": formulation,
+            "mass_formulation_note": f"{formulation} ({chosen_by}; {MASS_NOTES[formulation]})",
             "ignored_cards": ignored,
             "params_ignored": ignored_params,
             "card_counts": dict(counts),
@@ -269,7 +283,7 @@ class _Deck:
             rigid_links=tuple(links),
             interpolations=tuple(interps),
             frames=tuple(f for k, f in frames.items() if k != 0),
-            mass_formulation="lumped" if lumped else "consistent",
+            mass_formulation=formulation,
             constraints=tuple(constraints),
             source=self.path,
             meta=meta,
@@ -922,6 +936,7 @@ def load_bdf(
     wtmass: float | None = None,
     spc: int | None = None,
     points: Sequence[ModalPoint] | None = None,
+    coupled_mass: str | None = None,
 ) -> GraphModel:
     """Read a NASTRAN bulk data deck into a graph model, SI.
 
@@ -940,14 +955,31 @@ def load_bdf(
         SPC set noted as the model's constraints; default the case control's ``SPC = n``.
     points : sequence of ModalPoint, optional
         Named points on grids (a points file, :func:`microg.models.modal.read_options`).
+    coupled_mass : {"coupled", "coupled-nx9", "consistent"}, optional
+        The mass of a deck with ``PARAM,COUPMASS`` > 0: NASTRAN's coupled CBAR mass as
+        Simcenter Nastran 2020.2 forms it (``"coupled"``, default
+        :data:`microg.defaults.NASTRAN_COUPLED_MASS`) or as NX Nastran 9.1 (2014) does
+        (``"coupled-nx9"``), or microg's consistent mass (``"consistent"``: with torsional
+        inertia, which NASTRAN's CBAR has not; a straight line of CBARs then keeps the
+        inertia of its rotation about its axis); see :mod:`microg.structure.elements`.  A
+        deck without COUPMASS is lumped whatever this says.
 
     Returns
     -------
     GraphModel
-        Mass formulation lumped unless ``PARAM,COUPMASS`` > 0; ``constraints`` the SPC set
-        (not applied unless :func:`~microg.structure.frame.build_frame` is asked to);
-        ``meta`` the units, WTMASS, ignored cards and parameters, and ``warnings``.
+        Mass formulation lumped unless ``PARAM,COUPMASS`` > 0, else ``coupled_mass``;
+        ``constraints`` the SPC set (not applied unless
+        :func:`~microg.structure.frame.build_frame` is asked to); ``meta`` the units, WTMASS,
+        the mass formulation and what chose it (``mass_formulation_note``), ignored cards and
+        parameters, and ``warnings``.
     """
+    form = defaults.NASTRAN_COUPLED_MASS if coupled_mass is None else coupled_mass
+    if form not in NASTRAN_COUPLED_FORMS:
+        raise InputError(
+            f"unknown coupled mass {coupled_mass!r}",
+            where="coupled_mass",
+            fix="use " + ", ".join(NASTRAN_COUPLED_FORMS),
+        )
     if isinstance(units, UnitSystem):
         system = units
         if wtmass is None and units.wtmass_given:
@@ -965,6 +997,7 @@ def load_bdf(
     cards, case = read_cards(path, notes)
     sc = Scales(system.length_m, system.force_N, system.time_s)
     deck = _Deck(cards, case, str(path), sc, wtmass, spc)
+    deck.coupled_form = form
     deck.warnings.extend(notes)
     graph = deck.build()
     if not points:

@@ -49,7 +49,7 @@ def validate_graph(graph: GraphModel) -> None:
         raise InputError(
             f"unknown mass formulation {graph.mass_formulation!r}",
             where=f"{src}: mass",
-            fix="use lumped or consistent",
+            fix="use " + ", ".join(MASS_FORMULATIONS),
         )
     for label, items in (
         ("node", graph.nodes),

@@ -22,8 +22,10 @@ Conventions (all values SI: m, kg, s, N, rad):
   a beam takes the basic axis least aligned with it (:func:`default_orientation`).
 * **Springs** (CBUSH) take their axes from a coordinate system, or from their nodes and an
   orientation vector (:func:`spring_axes`).
-* **Mass formulation** is the model's: ``"lumped"`` (NASTRAN's default) or ``"consistent"``
-  (NASTRAN's ``PARAM,COUPMASS``); :mod:`microg.structure.elements` documents both.
+* **Mass formulation** is the model's: ``"lumped"`` (NASTRAN's default), ``"consistent"``
+  (microg's), or NASTRAN's ``PARAM,COUPMASS`` mass of CBARs, ``"coupled"`` (Simcenter Nastran
+  2020.2) and ``"coupled-nx9"`` (NX Nastran 9.1); :mod:`microg.structure.elements` documents
+  them.
 """
 
 from __future__ import annotations
@@ -42,6 +44,8 @@ from microg.models.coords import CoordinateFrame
 __all__ = [
     "COMPONENTS",
     "MASS_FORMULATIONS",
+    "MASS_NOTES",
+    "NASTRAN_COUPLED_FORMS",
     "MAX_GRAPH_ITEMS",
     "PARALLEL_TOL",
     "ZERO_LENGTH_TOL",
@@ -65,8 +69,23 @@ __all__ = [
 
 #: the six components of a node, NASTRAN's numbering: 1-3 translations, 4-6 rotations
 COMPONENTS = "123456"
-#: mass formulations of beams and rods
-MASS_FORMULATIONS = ("lumped", "consistent")
+#: mass formulations of beams and rods: "lumped" (NASTRAN's default), "consistent" (microg's), and NASTRAN's PARAM,COUPMASS mass of
+#: CBARs as Simcenter Nastran 2020.2 ("coupled") and NX Nastran 9.1 ("coupled-nx9") form it
+MASS_FORMULATIONS = ("lumped", "consistent", "coupled", "coupled-nx9")
+#: the mass a deck with PARAM,COUPMASS > 0 may be read with: NASTRAN's coupled CBAR mass as
+#: Simcenter 2020.2 or NX 9.1 form it, or microg's consistent mass (torsional inertia too)
+NASTRAN_COUPLED_FORMS = ("coupled", "coupled-nx9", "consistent")
+#: what each mass formulation is, one line for the output
+MASS_NOTES = {
+    "lumped": "half of each element's mass on each end's translations, a CBEAM's polar "
+    "moment on its axial rotations too",
+    "consistent": "microg's consistent mass: cubic (Timoshenko) translation, rotary and "
+    "torsional inertia",
+    "coupled": "NASTRAN's coupled CBAR mass as Simcenter Nastran 2020.2 forms it: consistent "
+    "translation, no torsional inertia, the two ends' rotations uncoupled",
+    "coupled-nx9": "NASTRAN's coupled CBAR mass as NX Nastran 9.1 forms it: consistent "
+    "translation, no torsional inertia",
+}
 #: largest number of nodes, elements, masses... of each kind in one model (documented limit)
 MAX_GRAPH_ITEMS = 2_000_000
 #: a beam whose end points are closer than this fraction of the model size has zero length
@@ -361,7 +380,7 @@ class GraphModel:
     points : tuple of GraphPoint
     frames : tuple of CoordinateFrame
         The coordinate systems the model was written in (for reference).
-    mass_formulation : {"lumped", "consistent"}
+    mass_formulation : {"lumped", "consistent", "coupled", "coupled-nx9"}
     constraints : tuple of Constraint
         Single-point constraints of the source (NASTRAN SPC): not applied by default, microg
         models being free-free.

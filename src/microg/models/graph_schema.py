@@ -192,7 +192,7 @@ class GraphIn(TableIn):
     name: _GName
     description: Text = ""
     units: Literal["SI", "US"] | None = None
-    mass: Literal["lumped", "consistent"] = "consistent"
+    mass: Literal["lumped", "consistent", "coupled", "coupled-nx9"] = "consistent"
 
 
 class FrameIn(TableIn):

@@ -19,7 +19,10 @@ import numpy as np
 from microg.errors import InputError
 from microg.models.graph_check import validate_graph
 from microg.models.graph_model import BeamSection, GraphModel
+from microg.models.graph_model import MASS_FORMULATIONS
 from microg.structure.elements import (
+    BAR_COUPLED_FORMS,
+    bar_mass_coupled_local,
     beam_mass_consistent_local,
     beam_mass_lumped_local,
     beam_stiffness_local,
@@ -152,8 +155,10 @@ def assemble_frame(graph: GraphModel, *, mass: str | None = None) -> FrameMatric
     Parameters
     ----------
     graph : GraphModel
-    mass : {"lumped", "consistent"}, optional
-        Overrides the model's mass formulation.
+    mass : {"lumped", "consistent", "coupled", "coupled-nx9"}, optional
+        Overrides the model's mass formulation (:mod:`microg.structure.elements`: the two
+        ``coupled`` forms are NASTRAN's COUPMASS mass of CBARs; other elements take the
+        consistent mass under them).
 
     Returns
     -------
@@ -161,11 +166,11 @@ def assemble_frame(graph: GraphModel, *, mass: str | None = None) -> FrameMatric
     """
     validate_graph(graph)
     formulation = graph.mass_formulation if mass is None else mass
-    if formulation not in ("lumped", "consistent"):
+    if formulation not in MASS_FORMULATIONS:
         raise InputError(
             f"unknown mass formulation {formulation!r}",
             where="mass",
-            fix="use lumped or consistent",
+            fix="use " + ", ".join(MASS_FORMULATIONS),
         )
     lumped = formulation == "lumped"
     index = graph.node_index()
@@ -225,6 +230,15 @@ def assemble_frame(graph: GraphModel, *, mass: str | None = None) -> FrameMatric
             if skew.size:
                 ry[skew] = rz[skew] = 0.5 * (ry[skew] + rz[skew])
             ml = beam_mass_consistent_local(L, mpl, polar, phi_v, phi_w, ry, rz)
+            bars = np.flatnonzero([b.kind == "bar" for b in bm])
+            if formulation in BAR_COUPLED_FORMS and bars.size:
+                ml[bars] = bar_mass_coupled_local(
+                    L[bars],
+                    mpl[bars],
+                    phi_v[bars],
+                    phi_w[bars],
+                    end_rotation_coupling=BAR_COUPLED_FORMS[formulation],
+                )
         rel = np.zeros((len(bm), 12), bool)
         for e, b in enumerate(bm):
             for end, comps in enumerate(b.releases):

@@ -15,12 +15,19 @@ assembly (:mod:`microg.structure.assembly`) rotates them to the basic frame.
     rotations carry no mass; see condensation below).  This reproduces Simcenter Nastran's
     grid-point weight table and eigenvalues of the ``beam_modes`` fixture to its printed
     digits (``tests/validation/test_nastran_beam_modes.py``).
-  - ``"consistent"`` (NASTRAN ``PARAM,COUPMASS``): the consistent mass of the shear-deformable
-    element, translational and rotary inertia (Przemieniecki Eq. 11.41; Friedman & Kosmatka,
-    *Computers & Structures* 47 (1993) 473, interdependent interpolation), torsion
-    ``rho J L / 6 [[2, 1], [1, 2]]``.  At ``phi = 0`` without rotary inertia it is
-    :func:`frame_mass_local`.  (NASTRAN's own coupled CBAR mass was not
-    available to check against; the difference, if any, is in the shear terms only.)
+  - ``"consistent"`` (microg's own, the default of graph and station models): the consistent
+    mass of the shear-deformable element, translational and rotary inertia (Przemieniecki
+    Eq. 11.41; Friedman & Kosmatka, *Computers & Structures* 47 (1993) 473, interdependent
+    interpolation), torsion ``rho J L / 6 [[2, 1], [1, 2]]``.  At ``phi = 0`` without rotary
+    inertia it is :func:`frame_mass_local`.
+  - ``"coupled"`` and ``"coupled-nx9"`` (NASTRAN ``PARAM,COUPMASS`` > 0, CBAR only;
+    :func:`bar_mass_coupled_local`): the translational part of the consistent mass and **no**
+    torsional inertia; ``"coupled"`` (Simcenter Nastran 2020.2) also leaves out the coupling
+    ``-3 m' L^3 / 420`` between the two ends' bending rotations, ``"coupled-nx9"`` (NX Nastran
+    9.1, 2014) keeps it.  Both were identified from the runs' own output on the same bulk data
+    (their weight checks and fixed-boundary eigenvalues agree with these forms to their printed
+    digits, ``tests/validation/test_nastran_bar_mass.py``); no vendor document describing either
+    was found.  A CBEAM under COUPMASS keeps ``"consistent"`` (no NASTRAN run to check it).
 
   Offsets (CBAR WA/WB) are rigid links from the node to the beam end; pin flags release end
   components by static condensation of the element (its mass by the same transformation).
@@ -45,8 +52,10 @@ import numpy as np
 from microg.errors import InputError
 
 __all__ = [
+    "BAR_COUPLED_FORMS",
     "DOF_NAMES",
     "INTERPOLATION_COND_MAX",
+    "bar_mass_coupled_local",
     "beam_mass_consistent_local",
     "beam_mass_lumped_local",
     "beam_stiffness_local",
@@ -64,6 +73,9 @@ __all__ = [
     "skew",
 ]
 
+#: NASTRAN's coupled CBAR mass (PARAM,COUPMASS > 0) as each release forms it, by the name of
+#: the mass formulation: whether the two ends' bending rotations are coupled
+BAR_COUPLED_FORMS = {"coupled": False, "coupled-nx9": True}
 #: coordinate names of a node, in order
 DOF_NAMES = ("ux", "uy", "uz", "rx", "ry", "rz")
 #: an RBE3 whose normal matrix has a condition number above this is singular
@@ -424,6 +436,49 @@ def beam_mass_consistent_local(
             out[e[:, None, None], ix[None, :, None], ix[None, None, :]] = _plane_mass(
                 L[e], m[e], rot[e], phi[e], s
             )
+    return out
+
+
+def bar_mass_coupled_local(
+    length: np.ndarray,
+    mass_per_length: np.ndarray,
+    phi_v: np.ndarray | None = None,
+    phi_w: np.ndarray | None = None,
+    *,
+    end_rotation_coupling: bool = False,
+) -> np.ndarray:
+    """NASTRAN's coupled (``PARAM,COUPMASS``) mass of CBAR elements in local axes.
+
+    The translational inertia of :func:`beam_mass_consistent_local` (axial
+    ``m' L/6 [[2, 1], [1, 2]]``; per bending plane the cubic element's, with ``phi`` its
+    Timoshenko form) and no torsional or rotary inertia.  Without ``end_rotation_coupling``
+    (Simcenter Nastran 2020.2) the terms between the two ends' bending rotations,
+    ``-3 m' L^3 / 420`` at ``phi = 0``, are zero: the element's rigid-body inertia about its
+    centre is then ``m' L^3 / 12 + m' L^3 / 70`` across the axis (the weight check of that
+    release) instead of the exact ``m' L^3 / 12`` (NX Nastran 9.1, ``end_rotation_coupling``).
+    Both forms are fitted to the runs' printed output (weight check and eigenvalues to 7
+    digits); the shear terms (``phi != 0``) have no NASTRAN run behind them.
+
+    Parameters
+    ----------
+    length : ndarray (ne,)
+        m.
+    mass_per_length : ndarray (ne,)
+        ``m'``, kg/m.
+    phi_v, phi_w : ndarray (ne,), optional
+        Shear parameters of the v (x-y) and w (x-z) planes (:func:`shear_parameter`).
+    end_rotation_coupling : bool
+        Keep the coupling of the two ends' bending rotations (NX Nastran 9.1).
+
+    Returns
+    -------
+    ndarray (ne, 12, 12)
+    """
+    L = np.asarray(length, float)
+    out = beam_mass_consistent_local(L, mass_per_length, np.zeros_like(L), phi_v, phi_w)
+    if not end_rotation_coupling:
+        for a, b in ((5, 11), (4, 10)):
+            out[:, a, b] = out[:, b, a] = 0.0
     return out
 
 
