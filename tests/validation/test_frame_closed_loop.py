@@ -9,8 +9,8 @@ The reference is a plain dense assembly written here from the textbook element m
 (Przemieniecki, *Theory of Matrix Structural Analysis*: Eq. 5.115 beam stiffness, Eq. 11.42
 consistent mass in NASTRAN's coupled CBAR form under COUPMASS; rod ``EA/L``; the CONM2
 rigid-body mass; the CBUSH ``[[k, -k], [-k, k]]``), solved in the deck's own units by scipy
-(QZ on the singular lumped-mass pencil, ``eigh`` for the coupled one).  It shares no code with microg's kernels, assembler, link
-elimination or condensation.
+(QZ on the singular lumped-mass pencil, ``eigh`` for the coupled one).  It shares no code
+with microg's kernels, assembler, link elimination or condensation.
 """
 
 from __future__ import annotations

@@ -73,12 +73,12 @@ from microg.models.coords import (
 from microg.models.file_units import UnitSystem, parse_units
 from microg.models.graph_check import validate_graph
 from microg.models.graph_model import (
+    MASS_NOTES,
+    NASTRAN_COUPLED_FORMS,
     BeamElement,
     BeamSection,
     ConcentratedMass,
     Constraint,
-    MASS_NOTES,
-    NASTRAN_COUPLED_FORMS,
     GraphModel,
     GraphPoint,
     Interpolation,

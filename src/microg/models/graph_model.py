@@ -69,8 +69,9 @@ __all__ = [
 
 #: the six components of a node, NASTRAN's numbering: 1-3 translations, 4-6 rotations
 COMPONENTS = "123456"
-#: mass formulations of beams and rods: "lumped" (NASTRAN's default), "consistent" (microg's), and NASTRAN's PARAM,COUPMASS mass of
-#: CBARs as Simcenter Nastran 2020.2 ("coupled") and NX Nastran 9.1 ("coupled-nx9") form it
+#: mass formulations of beams and rods: "lumped" (NASTRAN's default), "consistent" (microg's),
+#: and NASTRAN's PARAM,COUPMASS mass of CBARs as Simcenter Nastran 2020.2 ("coupled") and NX
+#: Nastran 9.1 ("coupled-nx9") form it
 MASS_FORMULATIONS = ("lumped", "consistent", "coupled", "coupled-nx9")
 #: the mass a deck with PARAM,COUPMASS > 0 may be read with: NASTRAN's coupled CBAR mass as
 #: Simcenter 2020.2 or NX 9.1 form it, or microg's consistent mass (torsional inertia too)

@@ -18,8 +18,7 @@ import numpy as np
 
 from microg.errors import InputError
 from microg.models.graph_check import validate_graph
-from microg.models.graph_model import BeamSection, GraphModel
-from microg.models.graph_model import MASS_FORMULATIONS
+from microg.models.graph_model import MASS_FORMULATIONS, BeamSection, GraphModel
 from microg.structure.elements import (
     BAR_COUPLED_FORMS,
     bar_mass_coupled_local,
