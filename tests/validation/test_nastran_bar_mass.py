@@ -152,3 +152,35 @@ def test_element_rigid_inertia_by_hand():
     u = np.zeros(12)
     u[[2, 8]] = 1.0
     assert u @ m[0] @ u == pytest.approx(mpl * L, rel=1e-14)
+
+
+def test_modes_command_states_the_choice_and_takes_the_option(capsys, tmp_path):
+    import json
+
+    from microg.cli import main
+
+    deck = tmp_path / "outboard.dat"
+    deck.write_text((DATA / "cla_outboard.blk").read_text())
+    rc = main(["modes", str(deck), "--units", UNITS, "--n-modes", "8"])
+    out, err = capsys.readouterr()
+    assert rc == 0 and err == ""
+    assert out.splitlines()[1].startswith("  mass: coupled (PARAM,COUPMASS,1 in the deck;")
+    rc = main(["modes", str(deck), "--units", UNITS, "--n-modes", "8"]
+              + ["--coupled-mass", "coupled-nx9", "--json"])  # fmt: skip
+    out, _ = capsys.readouterr()
+    assert rc == 0 and json.loads(out)["mass_formulation"]["name"] == "coupled-nx9"
+    # a reader option of decks only: an OP2's mass is the run's own
+    rc = main(
+        ["modes", str(DATA / "cla_residual.op2"), "--units", UNITS, "--coupled-mass", "coupled"]
+    )
+    _, err = capsys.readouterr()
+    assert rc == 2 and err.count("\n") == 1 and "--coupled-mass: applies to NASTRAN decks" in err
+
+
+def test_provenance_records_the_mass_formulation():
+    from microg.analysis.provenance import provenance_record
+
+    g = load_bdf(DATA / "cla_outboard.blk", units=UNITS, coupled_mass="coupled-nx9")
+    rec = provenance_record(g, None)
+    assert rec["mass_formulation"] == "coupled-nx9"
+    assert rec["mass_formulation_note"].startswith("coupled-nx9 (PARAM,COUPMASS,1 in the deck")

@@ -55,6 +55,9 @@ def sha256_file(path: Path) -> str:
 def provenance_record(model: Any, command: str | None) -> dict[str, Any]:
     """The record of a run: version, UTC time, command, the model's path and SHA-256.
 
+    A frame (graph) model adds its mass formulation and what chose it (a NASTRAN deck's
+    ``PARAM,COUPMASS``, the reader's ``coupled_mass``).
+
     Parameters
     ----------
     model : a model object; its ``source`` (a file path or a shipped name) is hashed
@@ -80,10 +83,16 @@ def provenance_record(model: Any, command: str | None) -> dict[str, Any]:
                 sha = hashlib.sha256(data).hexdigest()
             except (OSError, ValueError):  # FileNotFoundError is an OSError
                 sha = None
-    return {
+    out = {
         "microg_version": __version__,
         "created_utc": _dt.datetime.now(_dt.UTC).strftime("%Y-%m-%dT%H:%M:%SZ"),
         "command": command,
         "model_path": path,
         "model_sha256": sha,
     }
+    form = getattr(model, "mass_formulation", None)
+    if isinstance(form, str):  # a frame (graph) model: its elements' mass and what chose it
+        meta = getattr(model, "meta", None) or {}
+        out["mass_formulation"] = form
+        out["mass_formulation_note"] = meta.get("mass_formulation_note", form)
+    return out

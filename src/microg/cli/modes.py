@@ -27,6 +27,7 @@ FLAGS = {
     "wtmass": "--wtmass",
     "points": "--points",
     "subcase": "--subcase",
+    "coupled_mass": "--coupled-mass",
     "constrained": "--constrained",
 }
 
@@ -100,6 +101,16 @@ def _effective_percent(m: Any) -> dict[str, Any]:
     help="An OP2 with modes of several subcases: the subcase to read.",
 )
 @click.option(
+    "--coupled-mass",
+    "coupled_mass",
+    type=click.Choice(["coupled", "coupled-nx9", "consistent"]),
+    default=None,
+    cls=Option,
+    show_default=f"{defaults.NASTRAN_COUPLED_MASS} (Simcenter Nastran 2020.2)",
+    help="A NASTRAN deck with PARAM,COUPMASS > 0: NASTRAN's coupled CBAR mass as Simcenter "
+    "2020.2 (coupled) or NX 9.1 (coupled-nx9) forms it, or microg's consistent mass.",
+)
+@click.option(
     "--constrained",
     is_flag=True,
     help="A NASTRAN deck or frame model: apply its SPCs (the clamped run) instead of the "
@@ -119,6 +130,7 @@ def modes(
     points: Path | None,
     uff_out: Path | None,
     subcase: int | None,
+    coupled_mass: str | None,
     constrained: bool,
     as_json: bool,
 ) -> None:
@@ -144,7 +156,13 @@ def modes(
         raise InputError("applies to --method ritz only", where="--functions")
     if uff_out is not None:  # before any work: a file that cannot be written is bad input
         uff_out = check_writable(uff_out, where="--uff", directory=False)
-    reader = (("units", units), ("wtmass", wtmass), ("points", points), ("subcase", subcase))
+    reader = (
+        ("units", units),
+        ("wtmass", wtmass),
+        ("points", points),
+        ("subcase", subcase),
+        ("coupled_mass", coupled_mass),
+    )
     options = {k: v for k, v in reader if v is not None}
     with flag_errors(FLAGS):
         mdl = microg.load_model(model, **options)
@@ -177,9 +195,12 @@ def modes(
     plane_out = structure.plane if structure.plane else (plane if fem_plane else None)
     name = getattr(mdl, "name", None) or structure.meta.get("model", model)
     replaced = structure.meta.get("replaced_rigid") or {"count": 0, "max_file_freq_hz": None}
+    mass = _mass_formulation(structure.meta, method)
     if as_json:
         data = m.to_dict()
         out = {"model": name, "plane": plane_out, **data, "replaced_rigid": replaced}
+        if mass is not None:
+            out["mass_formulation"] = mass
         warnings = list(structure.meta.get("warnings", ()))
         if warnings:
             out["warnings"] = warnings
@@ -189,6 +210,8 @@ def modes(
     dirs = list(pct)
     where = f", plane {plane_out}" if plane_out else ""
     click.echo(f"{name}: {m.n_modes} modes ({m.method}{where}, {structure.n_dof} coordinates)")
+    if mass is not None:
+        click.echo(f"  mass: {mass['note']}")
     if replaced and replaced.get("count"):
         click.echo(
             f"  {replaced['count']} of the file's modes replaced by exact rigid-body modes "
@@ -225,6 +248,17 @@ def modes(
         written(uff_out)
     for warning in structure.meta.get("warnings", ()):
         click.echo(f"  warning: {warning}")
+
+
+def _mass_formulation(meta: Any, method: str) -> dict[str, str] | None:
+    """The frame model's mass formulation and what chose it (None for other models)."""
+    from microg.models.graph_model import MASS_NOTES
+
+    form = meta.get("mass_formulation") if method == "fem" else None
+    if form is None:
+        return None
+    note = dict(meta.get("graph_meta") or {}).get("mass_formulation_note")
+    return {"name": form, "note": note or f"{form} ({MASS_NOTES.get(form, '')})"}
 
 
 def _pct(v: float) -> str:

@@ -82,6 +82,7 @@ def load_model(
     wtmass: float | None = None,
     points: str | Path | None = None,
     subcase: int | None = None,
+    coupled_mass: str | None = None,
 ) -> Any:
     """Read a model of any kind microg knows (see the module docstring).
 
@@ -97,6 +98,10 @@ def load_model(
         Points/options TOML file (named grids, kinds, and optionally ``units``/``wtmass``).
     subcase : int, optional
         The subcase of an OP2 with modes of several (an OP2 option only).
+    coupled_mass : {"coupled", "coupled-nx9", "consistent"}, optional
+        The mass of a NASTRAN deck with ``PARAM,COUPMASS`` > 0 (a deck option only;
+        :func:`microg.models.bdf.load_bdf`): default NASTRAN's coupled CBAR mass as current
+        Simcenter Nastran forms it (:data:`microg.defaults.NASTRAN_COUPLED_MASS`).
 
     Returns
     -------
@@ -107,6 +112,10 @@ def load_model(
     label = str(path)
     if subcase is not None and suffix != ".op2":
         raise InputError("applies to OP2 files only", where="subcase", fix="leave it out")
+    if coupled_mass is not None and suffix not in (".bdf", ".dat"):
+        raise InputError(
+            "applies to NASTRAN decks (.bdf, .dat) only", where="coupled_mass", fix="leave it out"
+        )
     if subcase is not None and (
         isinstance(subcase, bool) or not isinstance(subcase, int) or subcase < 1
     ):
@@ -136,7 +145,7 @@ def load_model(
         from microg.models.bdf import load_bdf
 
         u = _units(units, wtmass, opts, label, need=True)
-        return load_bdf(p, units=u, points=opts.points)
+        return load_bdf(p, units=u, points=opts.points, coupled_mass=coupled_mass)
     if not p.is_file():
         raise InputError("no such file", where=label)
     if suffix == ".npz":
