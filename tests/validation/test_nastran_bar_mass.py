@@ -184,3 +184,12 @@ def test_provenance_records_the_mass_formulation():
     rec = provenance_record(g, None)
     assert rec["mass_formulation"] == "coupled-nx9"
     assert rec["mass_formulation_note"].startswith("coupled-nx9 (PARAM,COUPMASS,1 in the deck")
+
+
+def test_ogpwg_truth_read_by_pynastran_too():
+    # the OGPWG truth above, read by pyNastran 1.4.1 (the numpy < 2 environment) as well
+    op2 = pytest.importorskip("pyNastran.op2.op2")
+    ref = op2.read_op2(str(DATA / "cla_residual.op2"), debug=None)
+    mo = ref.grid_point_weight["SUPERELEMENT 0"].MO
+    # the same float32 words widened to float64: equal to the bit (measured)
+    np.testing.assert_array_equal(read_op2_modes(DATA / "cla_residual.op2").rigid_mass, mo)
