@@ -355,11 +355,13 @@ def build_frame(
     if massless.size:
         if retained.size > condense_max:
             raise InputError(
-                f"{massless.size} DOFs carry no mass (lumped mass: bending rotations); condensing "
+                f"{massless.size} DOFs carry no mass (lumped mass: bending rotations; NASTRAN's "
+                "coupled CBAR mass: rotations about the bars' axes); condensing "
                 f"them exactly leaves {retained.size} DOFs, a dense matrix beyond the limit of "
                 f"{condense_max}",
                 where="mass",
-                fix="use mass='consistent' (NASTRAN PARAM,COUPMASS,1) or add rotary inertia",
+                fix="use mass='consistent' (a NASTRAN deck: PARAM,COUPMASS,1 read with "
+                "coupled_mass='consistent') or add rotary inertia",
             )
         Koo = Kn[massless][:, massless].tocsc()
         Koa = Kn[massless][:, retained].toarray()
