@@ -110,7 +110,7 @@ def validate_graph(graph: GraphModel) -> None:
             raise InputError(
                 f"{node!r} is a scalar point (SPOINT): it has no position or rotation",
                 where=f"{src}: {where}",
-                fix="connect a grid (scalar points take scalar elements, CELAS/CMASS/CDAMP, and MPC)",
+                fix="connect a grid (a scalar point takes scalar elements and MPCs)",
             )
 
     def dof_ref(node: str, comp: Any, where: str) -> None:

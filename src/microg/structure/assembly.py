@@ -281,8 +281,10 @@ def assemble_frame(graph: GraphModel, *, mass: str | None = None) -> FrameMatric
     nodes = graph.nodes
 
     def scalar_vector(dofs: tuple[tuple[str, int] | None, ...]) -> tuple[np.ndarray, np.ndarray]:
-        """DOFs and ``e_b - e_a`` of a scalar element's two components (a scalar point's
-        one DOF is slot 0 of its node)."""
+        """DOFs and ``e_b - e_a`` of a scalar element's two components.
+
+        A scalar point's one DOF is slot 0 of its node.
+        """
         dl: list[np.ndarray] = []
         vl: list[np.ndarray] = []
         for end, dof in enumerate(dofs):
