@@ -269,9 +269,8 @@ def rigid_rows(
     """
     r = rigid_link(np.asarray(positions, float) - point).reshape(-1, 6)
     if scalar is not None and np.any(scalar):
-        r = r.reshape(-1, 6, 6)
-        r[np.asarray(scalar, bool)] = 0.0
-        r = r.reshape(-1, 6)
+        rows = np.flatnonzero(np.repeat(np.asarray(scalar, bool), 6))
+        r[rows] = 0.0
     if basis is not None:
         r = np.asarray(basis.T @ r)
     return r
@@ -365,10 +364,10 @@ def build_frame(
     pos_ind = np.full(T.shape[0], -1)
     pos_ind[fm.independent] = np.arange(fm.independent.size)
     # a scalar point has one DOF: the other five slots of its node are not coordinates
-    for i in np.flatnonzero(scalar):
+    for si in np.flatnonzero(scalar):
         for k in range(1, 6):
-            if pos_ind[6 * i + k] >= 0:
-                keep[pos_ind[6 * i + k]] = False
+            if pos_ind[6 * si + k] >= 0:
+                keep[pos_ind[6 * si + k]] = False
     if constrained:
         index = graph.node_index()
         turned = turned_nodes(graph)

@@ -260,12 +260,12 @@ def link_transform(
             i = index[nd]
             nodes.add(i)
             for ch in comps:
-                c = int(ch) - 1
+                ci = int(ch) - 1
                 pos.append(P[i])
-                dirs.append(graph.nodes[i].axes[c % 3])
+                dirs.append(graph.nodes[i].axes[ci % 3])
                 wts.append(w)
-                rot.append(c >= 3)
-                cc, vv = rows.component(i, c)
+                rot.append(ci >= 3)
+                cc, vv = rows.component(i, ci)
                 cols.append(cc)
                 vals.append(vv)
         others = sorted(nodes - {ri})
@@ -373,8 +373,8 @@ def _moved(
     lcols = sorted(set(src_cols.tolist()) | {int(c) for e in eqs for c in e[0]})
     pos = {c: j for j, c in enumerate(lcols)}
     E = np.zeros((len(eqs), len(lcols)))
-    for r, (c_ref, v_ref, a6) in enumerate(eqs):
-        np.add.at(E[r], [pos[int(c)] for c in c_ref], v_ref)
+    for r, (cr, vr, a6) in enumerate(eqs):
+        np.add.at(E[r], [pos[int(c)] for c in cr], vr)
         np.add.at(E[r], [pos[int(c)] for c in src_cols], -(a6 @ src_vals))
     um: list[int] = []
     for nd, comps in ip.moved:
