@@ -155,3 +155,46 @@ def test_rbe3_um_must_match_refc(tmp_path):
     assert g.interpolations[0].moved == (("grid:1", "12"),)
     with pytest.raises(InputError, match="UM names 2 distinct component"):
         assemble_frame(g)
+
+
+TIED = """\
+SOL 103
+CEND
+BEGIN BULK
+GRID,10,,0.,0.,0.
+CONM2,1,10,,5.,,,,,+
++,1.,,1.,,,1.
+SPOINT,1
+CELAS2,22,400.,10,1,1,
+CMASS2,32,2.,1
+ENDDATA
+"""
+
+
+def test_scalar_point_tied_to_a_grid_keeps_six_rigid_modes(tmp_path):
+    # the scalar point moves with the grid in x under rigid translation (the static
+    # extension of the rigid vector); the one elastic mode is the two-mass oscillator,
+    # omega^2 = k (1/m1 + 1/m2)
+    m = solve_modes(build_frame(load_bdf(_deck(tmp_path, TIED, "tied.bdf"), units="m, N, s")))
+    assert int(np.sum(m.omega == 0.0)) == 6
+    # tolerance: a 2x2 eigenproblem, round-off only
+    assert m.omega[6:] == pytest.approx([np.sqrt(400.0 * (1 / 5.0 + 1 / 2.0))], rel=1e-12)
+
+
+def test_cli_refuses_to_observe_a_scalar_point(tmp_path):
+    import os
+    import subprocess
+    import sys
+
+    deck = _deck(tmp_path, TIED, "tied.bdf")
+    out = subprocess.run(
+        [sys.executable, "-m", "microg", "analyze", str(deck), "--units", "m,N,s"]
+        + ["--observe", "spoint:1", "--at", "grid:10", "--out", str(tmp_path / "run")],
+        capture_output=True,
+        text=True,
+        env={**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[2] / "src")},
+        timeout=300,
+    )
+    assert out.returncode == 2
+    lines = out.stderr.strip().splitlines()
+    assert len(lines) == 1 and "'spoint:1' is a scalar point (SPOINT)" in lines[0]

@@ -486,6 +486,8 @@ def build_frame(
     # as microg.structure.fem does), restricted to the retained coordinates
     r_ind = rigid_rows(P, cm, scalar, fm.working)[fm.independent]
     r_ret = (r_ind if Q is None else np.asarray(Q.T @ r_ind))[retained]
+    if scalar.any():
+        r_ret = _scalar_rigid(K_out, r_ret, labels)
     rigid = (
         {}
         if constrained and applied
@@ -539,6 +541,48 @@ def build_frame(
         samples=samples,
         meta=meta,
     )
+
+
+def _scalar_rigid(K: Any, r: np.ndarray, labels: tuple[str, ...]) -> np.ndarray:
+    """Rigid-body vectors carried onto the scalar points their elements tie to the grids.
+
+    A scalar point takes no part in rigid-body motion by itself (NASTRAN's rigid-body
+    geometry is zero there), but one tied by springs to grid components moves with them: its
+    motion is the static solution ``K_ss s = -K_sg r_g``.  When the extended vector is in
+    the null space of K, it is the exact rigid-body mode; when it is not (a scalar point
+    also grounded), the solver's test of ``K r`` rejects it as before.  A singular ``K_ss``
+    (a scalar point without stiffness) leaves the vectors as they are.
+
+    Parameters
+    ----------
+    K : ndarray or sparse (n, n)
+        Stiffness on the coordinates.
+    r : ndarray (n, 6)
+        Rigid-body vectors (zero at the scalar points).
+    labels : tuple of str
+        Coordinate labels: a scalar point's is its node name (``"spoint:7"``).
+    """
+    import scipy.sparse as sp
+    import scipy.sparse.linalg as spla
+
+    sc = np.array([lab.startswith("spoint:") and lab.count(":") == 1 for lab in labels], bool)
+    if not sc.any():
+        return r
+    Ks = sp.csr_matrix(K)
+    s_idx, g_idx = np.flatnonzero(sc), np.flatnonzero(~sc)
+    rhs = -np.asarray(Ks[s_idx][:, g_idx] @ r[g_idx])
+    if not np.any(rhs):
+        return r
+    try:
+        lu = spla.splu(sp.csc_matrix(Ks[s_idx][:, s_idx]))
+        piv = np.abs(lu.U.diagonal())
+        if piv.min() <= 1e-12 * piv.max():
+            return r
+        out = r.copy()
+        out[s_idx] = lu.solve(rhs)
+    except RuntimeError:
+        return r
+    return out
 
 
 #: coupled mass blocks up to this many DOFs are checked for massless directions
