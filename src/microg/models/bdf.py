@@ -11,10 +11,11 @@ the cards into the graph; :mod:`microg.models.bdf_properties` reads the property
 material cards.
 
 **Cards converted:** GRID (CP, CD), CORD2R/C/S, CBAR, CBEAM, BAROR, BEAMOR, PBAR, PBARL,
-PBEAM (uniform), PBEAML (uniform), CROD, PROD, CONROD, CBUSH + PBUSH (K, B, GE), CELAS1 +
-PELAS, CELAS2, CONM2, CONM1 (a rigid body's 6x6 mass), RBE2, RBE3 (translational
-independent components), MAT1, PARAM
-(WTMASS, COUPMASS; K6ROT noted), SPC, SPC1, SPCADD (noted as constraints).
+PBEAM (uniform), PBEAML (uniform), CROD, PROD, CONROD, CBUSH + PBUSH (K, B, GE), CONM2,
+CONM1 (a rigid body's 6x6 mass), MAT1, PARAM (WTMASS, COUPMASS; K6ROT noted); and through
+:mod:`microg.models.bdf_constraints`: SPOINT, CELAS1 + PELAS, CELAS2, CMASS1 + PMASS, CMASS2,
+CDAMP1 + PDAMP, CDAMP2, RBE2, RBE3 (rotations, UM), MPC, MPCADD (``MPC = n`` applied), SPC,
+SPC1, SPCADD (noted as constraints).
 
 **Cards ignored by name** (they change no stiffness or mass: loads, solution and output
 control) are counted in ``meta["ignored_cards"]`` and named in ``meta["warnings"]``; every

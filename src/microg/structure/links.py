@@ -1,14 +1,20 @@
-"""Rigid elements and constraints on frame DOFs: RBE2 and RBE3 eliminated exactly.
+"""Rigid elements and constraints on frame DOFs: RBE2, RBE3 and MPC eliminated exactly.
 
 **Rigid links** (RBE2): the dependent components are eliminated exactly,
   ``u_d = u_i + theta_i x (x_d - x_i)``, ``theta_d = theta_i`` (no penalty).  **Interpolation**
-(RBE3): the reference node's motion is the weighted least-squares rigid-body fit of the
-  independent nodes' translations (the sources' components along their axes), eliminated
-  exactly the same way; it adds no stiffness and moves rigid-body motion exactly.  Chains
-  of links are resolved; a component dependent twice, or a cycle, is an error.
+(RBE3): the reference node's motion is NASTRAN's weighted least-squares rigid-body fit of the
+  independent components, translations and rotations
+  (:func:`~microg.structure.elements.interpolation_matrix`), eliminated the same way; with UM
+  the element's equations are solved for the UM components instead.  It adds no stiffness and
+  moves rigid-body motion exactly.  **MPC**: ``sum a_j u_j = 0`` solved for its first term.
+  Chains are resolved; a component dependent twice (naming both elements), or a cycle, is an
+  error.
 
-Single-point constraints (SPC) and the links name components along a node's axes:
-:func:`basic_dofs` maps them to basic-frame DOFs.
+The equations are written on *working* DOFs: the basic-frame DOFs of each node, except at a
+node with rotated axes that has dependent or constrained components (:func:`turned_nodes`),
+whose DOFs are along its own axes (NASTRAN's global system), so that any subset of a triple
+can be dependent.  Single-point constraints (SPC) and the links name components along a
+node's axes: :func:`basic_dofs` maps them to basic-frame DOFs elsewhere.
 """
 
 from __future__ import annotations
