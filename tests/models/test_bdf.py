@@ -244,11 +244,20 @@ def test_rigid_elements_and_constraints(tmp_path):
     assert ip.sources == (("grid:5", "123", 1.0), ("grid:6", "123", 1.0), ("grid:2", "12", 2.0))
     cons = {(c.node, c.components) for c in g.constraints}
     assert cons == {("grid:1", "123"), ("grid:2", "123"), ("grid:3", "123"), ("grid:6", "456")}
-    # RBE3 with rotational independent components, or UM, is refused
+    # RBE3 with rotational independent components and UM (the moved dependent components)
+    # are read as written; ALPHA and what follows (thermal) are ignored
+    full = "RBE3,11,,4,123,1.0,123456,5,6,+\n+,UM,5,1,6,23,ALPHA,1.-5\n"
+    g2 = load_bdf(
+        _deck(tmp_path, text.replace(text[text.index("RBE3") :].split("CONM2")[0], full), "um.bdf"),
+        units="m, N, s",
+    )
+    ip = g2.interpolations[0]
+    assert ip.sources == (("grid:5", "123456", 1.0), ("grid:6", "123456", 1.0))
+    assert ip.moved == (("grid:5", "1"), ("grid:6", "23"))
     for bad, what in (
-        ("RBE3,11,,4,123456,1.0,123456,5", "rotational"),
-        ("RBE3,11,,4,123,1.0,123,5,6,+\n+,UM,4,1", "UM"),
         ("RBE3,11,,4,123,1.0,123,5,6,UM,4,1", "holds 8 data fields"),  # no field dropped
+        ("RBE3,11,,4,123,-1.0,123,5,6", "must be > 0"),
+        ("RBE3,11,,4,123,1.0,123,5,6,+\n+,UM,99,1", "GM grid 99 is not defined"),
     ):
         t2 = text.replace("RBE3,11,,4,123456,1.0,123,5,6,+\n+,2.0,12,2\n", bad + "\n")
         with pytest.raises(InputError, match=what):

@@ -451,7 +451,7 @@ def test_frequencies_invariant_under_rotation_of_the_model(yaw, tilt, roll):
     assert np.all(w2[:6] == 0.0)
 
 
-def test_discretize_of_a_graph_and_partial_components_need_basic_axes():
+def test_discretize_of_a_graph_and_partial_components_along_rotated_axes():
     from microg.structure.discretize import discretize
 
     g = _truss_loop("consistent")
@@ -463,13 +463,27 @@ def test_discretize_of_a_graph_and_partial_components_need_basic_axes():
     if s1 is not None:
         assert s1.dof_labels == s2.dof_labels
         np.testing.assert_array_equal(s1.stiffness.toarray(), s2.stiffness.toarray())
-    # "12" of a node with rotated axes is not a set of basic DOFs: refused with the fix
+    # "12" of a node with rotated axes is not a set of basic DOFs: the node's DOFs are then
+    # taken along its own axes (NASTRAN's global system), components 1 and 2 dependent
     axes = np.array([[0.6, 0.8, 0], [-0.8, 0.6, 0], [0, 0, 1.0]])
     nodes = (Node("m", np.zeros(3)), Node("r", np.array([1.0, 0, 0]), axes, "cs:9"))
     masses = (ConcentratedMass("mm", "m", 1.0, np.zeros(3), np.eye(3)),)
-    bad = GraphModel("x", nodes, masses=masses, rigid_links=(RigidLink("l", "m", ("r",), "12"),))
-    with pytest.raises(InputError, match="only all of 123 or none"):
-        assemble_frame(bad)
+    part = GraphModel("x", nodes, masses=masses, rigid_links=(RigidLink("l", "m", ("r",), "12"),))
+    fm = assemble_frame(part)
+    assert fm.transform.shape == (12, 10)  # 12 DOFs less the 2 dependent ones
+    # truth by hand: with m translating by t and rotating by th, r's basic motion is
+    # t + th x (1, 0, 0); its components along axes rows 0 and 1 follow it exactly, its
+    # component 3 and rotations stay independent (columns 7-10 are r's 3, 4, 5, 6)
+    rng = np.random.default_rng(3)
+    for _ in range(3):
+        t, th = rng.normal(size=3), rng.normal(size=3)
+        x3 = rng.normal(size=4)  # r's independent working DOFs: component 3, rotations 4-6
+        u = np.asarray(fm.transform @ np.concatenate([t, th, x3])).ravel()
+        ur = t + np.cross(th, [1.0, 0.0, 0.0])
+        # exact to round-off (products of O(1) numbers)
+        np.testing.assert_allclose(axes[:2] @ u[6:9], axes[:2] @ ur, atol=1e-14)
+        np.testing.assert_allclose(axes[2] @ u[6:9], x3[0], atol=1e-14)
+        np.testing.assert_allclose(axes @ u[9:12], x3[1:], atol=1e-14)
     ok = GraphModel("x", nodes, masses=masses, rigid_links=(RigidLink("l", "m", ("r",), "123"),))
     assert assemble_frame(ok).transform.shape == (12, 9)
 

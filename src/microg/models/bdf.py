@@ -11,10 +11,11 @@ the cards into the graph; :mod:`microg.models.bdf_properties` reads the property
 material cards.
 
 **Cards converted:** GRID (CP, CD), CORD2R/C/S, CBAR, CBEAM, BAROR, BEAMOR, PBAR, PBARL,
-PBEAM (uniform), PBEAML (uniform), CROD, PROD, CONROD, CBUSH + PBUSH (K, B, GE), CELAS1 +
-PELAS, CELAS2, CONM2, CONM1 (a rigid body's 6x6 mass), RBE2, RBE3 (translational
-independent components), MAT1, PARAM
-(WTMASS, COUPMASS; K6ROT noted), SPC, SPC1, SPCADD (noted as constraints).
+PBEAM (uniform), PBEAML (uniform), CROD, PROD, CONROD, CBUSH + PBUSH (K, B, GE), CONM2,
+CONM1 (a rigid body's 6x6 mass), MAT1, PARAM (WTMASS, COUPMASS; K6ROT noted); and through
+:mod:`microg.models.bdf_constraints`: SPOINT, CELAS1 + PELAS, CELAS2, CMASS1 + PMASS, CMASS2,
+CDAMP1 + PDAMP, CDAMP2, RBE2, RBE3 (rotations, UM), MPC, MPCADD (``MPC = n`` applied), SPC,
+SPC1, SPCADD (noted as constraints).
 
 **Cards ignored by name** (they change no stiffness or mass: loads, solution and output
 control) are counted in ``meta["ignored_cards"]`` and named in ``meta["warnings"]``; every
@@ -50,6 +51,7 @@ import numpy as np
 
 from microg import defaults
 from microg.errors import InputError
+from microg.models import bdf_constraints
 from microg.models.bdf_cards import MAX_CARDS, MAX_INCLUDE_DEPTH, Card, read_cards
 from microg.models.bdf_properties import (
     SECTION_SHEAR_FACTORS,
@@ -61,7 +63,6 @@ from microg.models.bdf_properties import (
     bush_properties,
     material,
     materials,
-    scalar_spring_properties,
 )
 from microg.models.coords import (
     NASTRAN_KINDS,
@@ -81,11 +82,8 @@ from microg.models.graph_model import (
     Constraint,
     GraphModel,
     GraphPoint,
-    Interpolation,
     Node,
-    RigidLink,
     RodElement,
-    ScalarSpring,
     Spring,
     parse_components,
     spring_axes,
@@ -110,6 +108,7 @@ SUPPORTED_CARDS = (
     "GRID", "CORD2R", "CORD2C", "CORD2S", "CBAR", "CBEAM", "BAROR", "BEAMOR", "PBAR", "PBARL",
     "PBEAM", "PBEAML", "CROD", "PROD", "CONROD", "CBUSH", "PBUSH", "CELAS1", "CELAS2", "PELAS",
     "CONM2", "CONM1", "RBE2", "RBE3", "MAT1", "PARAM", "SPC", "SPC1", "SPCADD",
+    "SPOINT", "CMASS1", "CMASS2", "PMASS", "CDAMP1", "CDAMP2", "PDAMP", "MPC", "MPCADD",
 )
 # fmt: on
 # fmt: off
@@ -168,6 +167,7 @@ class _Deck:
         sc: Scales,
         wtmass: float | None,
         spc: int | None,
+        mpc: int | None = None,
     ):
         self.cards = cards
         self.case = case
@@ -175,6 +175,9 @@ class _Deck:
         self.sc = sc
         self.user_wtmass = wtmass
         self.user_spc = spc
+        self.user_mpc = mpc
+        self.spoint_ids: set[int] = set()
+        self.mpc_sets: list[int] = []
         self.warnings: list[str] = []
         self.origin: dict[str, Card] = {}
         self.grid_cards: dict[int, Card] = {}
@@ -246,6 +249,7 @@ class _Deck:
             )
         frames = self.frames()
         nodes, grid_pos, grid_axes = self.grids(frames)
+        nodes = self.with_scalar_points(nodes)
         mats = materials(self.by_id(("MAT1",), "material"), self.sc)
         beam_props = beam_properties(
             self.by_id(("PBAR", "PBARL", "PBEAM", "PBEAML"), "beam property"), self.warnings
@@ -253,10 +257,11 @@ class _Deck:
         beams = self.beams(beam_props, mats, grid_pos, grid_axes, wt)
         rods = self.rods(mats, grid_pos, wt)
         springs = self.bushes(grid_pos, grid_axes, frames)
-        scalars = self.scalar_springs()
+        scalars = bdf_constraints.scalar_springs(self) + bdf_constraints.scalar_dampers(self)
         masses = self.conm2(grid_pos, frames, wt) + self.conm1(grid_pos, frames, wt)
-        links, interps = self.rigid(grid_pos)
-        constraints = self.constraints(grid_pos)
+        links, interps = bdf_constraints.rigid(self, grid_pos)
+        mpcs = bdf_constraints.mpcs(self)
+        constraints = bdf_constraints.constraints(self, grid_pos)
         for ps_node, comps in self.grid_ps:
             constraints.append(Constraint(ps_node, comps))
         ignored_params = sorted(k for k in params if k not in ("WTMASS", "COUPMASS"))
@@ -270,6 +275,8 @@ class _Deck:
             "params_ignored": ignored_params,
             "card_counts": dict(counts),
             "spc_sets": self.spc_sets,
+            "mpc_sets": self.mpc_sets,
+            "scalar_points": len(self.spoint_ids),
             "warnings": tuple(self.warnings),
         }
         graph = GraphModel(
@@ -282,6 +289,8 @@ class _Deck:
             masses=tuple(masses),
             rigid_links=tuple(links),
             interpolations=tuple(interps),
+            scalar_masses=tuple(bdf_constraints.scalar_masses(self, wt)),
+            mpcs=tuple(mpcs),
             frames=tuple(f for k, f in frames.items() if k != 0),
             mass_formulation=formulation,
             constraints=tuple(constraints),
@@ -391,6 +400,20 @@ class _Deck:
                 self.grid_ps.append((name, self.components(ps, c, "PS")))
             self.origin[name] = c
         return nodes, pos, axes
+
+    def with_scalar_points(self, nodes: list[Node]) -> list[Node]:
+        """The grids' nodes and the SPOINTs' (one DOF each), ordered by id as NASTRAN's g-set."""
+        ids = bdf_constraints.scalar_points(self)
+        clash = [i for i in ids if i in self.grid_cards]
+        if clash:
+            raise self.grid_cards[clash[0]].error(
+                f"id {clash[0]} is both a GRID and an SPOINT", "give each point its own id"
+            )
+        self.spoint_ids = set(ids)
+        if not ids:
+            return nodes
+        spoints = [Node(f"spoint:{i}", np.zeros(3), np.eye(3), "scalar", True) for i in ids]
+        return sorted(nodes + spoints, key=lambda nd: int(nd.name.split(":")[1]))
 
     def components(self, value: Any, c: Card, label: str, allowed: str = "123456") -> str:
         try:
@@ -628,54 +651,6 @@ class _Deck:
             out.append(Spring(ename, (ga, gb), k6, b6, ax, loc, ge))
         return out
 
-    def scalar_springs(self) -> list[ScalarSpring]:
-        sc = self.sc
-        pelas = scalar_spring_properties([c for c in self.cards if c.name == "PELAS"])
-        out: list[ScalarSpring] = []
-        grids = self.grid_cards
-        for eid, c in self.by_id(("CELAS1", "CELAS2"), "element").items():
-            if c.name == "CELAS1":
-                pid = c.integer(2, "PID", eid)
-                if pid not in pelas:
-                    raise c.error(
-                        f"property {pid} (PELAS) is not defined",
-                        "add the PELAS card or correct PID",
-                    )
-                k, ge, _ = pelas[pid]
-            else:
-                k, ge = c.real(2, "K"), c.real(7, "GE", 0.0)
-            dofs: list[tuple[str, int] | None] = []
-            kinds = []
-            for gi, ci in ((3, 4), (5, 6)):
-                g = c.raw(gi)
-                comp = c.raw(ci)
-                if g in (None, 0):
-                    dofs.append(None)
-                    continue
-                if g not in grids:
-                    raise c.error(
-                        f"grid {g} is not defined (scalar points, SPOINT, are not supported)"
-                    )
-                if not isinstance(comp, int) or comp not in range(1, 7):
-                    raise c.error(
-                        f"component {comp!r} must be 1-6 (scalar points are not supported)"
-                    )
-                dofs.append((f"grid:{g}", comp))
-                kinds.append(comp > 3)
-            if not kinds:
-                raise c.error("connects no grid")
-            n_rot = sum(kinds)
-            if n_rot == 0:
-                scale = sc.force / sc.length
-            elif n_rot == len(kinds):
-                scale = sc.force * sc.length
-            else:
-                scale = sc.force
-            ename = f"{c.name.lower()}:{eid}"
-            self.origin[ename] = c
-            out.append(ScalarSpring(ename, (dofs[0], dofs[1]), k * scale, 0.0, ge))
-        return out
-
     def conm2(
         self, pos: dict[int, np.ndarray], frames: dict[int, CoordinateFrame], wt: float
     ) -> list[ConcentratedMass]:
@@ -769,120 +744,6 @@ class _Deck:
             out.append(ConcentratedMass(ename, node, m, d, jc))
         return out
 
-    def rigid(self, pos: dict[int, np.ndarray]) -> tuple[list[RigidLink], list[Interpolation]]:
-        links: list[RigidLink] = []
-        interps: list[Interpolation] = []
-        for eid, c in self.by_id(("RBE2",), "element").items():
-            gn = self.grid(c.raw(2), c, pos, "GN")
-            cm = self.components(c.raw(3), c, "CM")
-            deps = []
-            for k in range(4, len(c)):
-                v = c.raw(k)
-                if v is None:
-                    continue
-                if isinstance(v, float) and k == len(c) - 1:
-                    break  # ALPHA (thermal expansion)
-                if not isinstance(v, int):
-                    raise c.error(f"field {k + 1}: expected a grid id, got {v!r}")
-                deps.append(self.grid(v, c, pos, "GM"))
-            if not deps:
-                raise c.error("has no dependent grid")
-            ename = f"rbe2:{eid}"
-            self.origin[ename] = c
-            links.append(RigidLink(ename, gn, tuple(deps), cm))
-        for eid, c in self.by_id(("RBE3",), "element").items():
-            ref = self.grid(c.raw(3), c, pos, "REFGRID")
-            refc = self.components(c.raw(4), c, "REFC")
-            srcs: list[tuple[str, str, float]] = []
-            k = 5
-            while k < len(c):
-                v = c.raw(k)
-                if v is None:
-                    k += 1
-                    continue
-                if isinstance(v, str):
-                    if v == "ALPHA":
-                        break
-                    raise c.error(f"{v} (moved dependent DOFs) is not supported", "remove UM")
-                w = float(v)
-                comps = self.components(c.raw(k + 1), c, "C")
-                if any(ch in "456" for ch in comps):
-                    raise c.error(
-                        "rotational independent components (4-6) are not supported",
-                        "give the independent grids' translations 123 only",
-                    )
-                k += 2
-                gids = []
-                while k < len(c) and isinstance(c.raw(k), int | type(None)):
-                    if c.raw(k) is not None:
-                        gids.append(c.raw(k))
-                    k += 1
-                if not gids:
-                    raise c.error("a weight has no grid")
-                srcs += [(self.grid(g, c, pos, "G"), comps, w) for g in gids]
-            ename = f"rbe3:{eid}"
-            self.origin[ename] = c
-            interps.append(Interpolation(ename, ref, refc, tuple(srcs)))
-        return links, interps
-
-    def constraints(self, pos: dict[int, np.ndarray]) -> list[Constraint]:
-        sets: dict[int, list[tuple[str, str]]] = {}
-        adds: dict[int, list[int]] = {}
-        for c in self.cards:
-            if c.name == "SPC":
-                sid = c.integer(1, "SID")
-                for base in (2, 5):
-                    g = c.raw(base)
-                    if g is None:
-                        continue
-                    node = self.grid(g, c, pos, "G")
-                    comps = self.components(c.raw(base + 1), c, "C")
-                    if c.real(base + 2, "D", 0.0):
-                        self.warnings.append(f"{c.where}: enforced displacement ignored")
-                    sets.setdefault(sid, []).append((node, comps))
-            elif c.name == "SPC1":
-                sid = c.integer(1, "SID")
-                comps = self.components(c.raw(2), c, "C")
-                ids = list(c.fields[3:])
-                if len(ids) == 3 and ids[1] == "THRU":
-                    lo, hi = ids[0], ids[2]
-                    ids = [
-                        g
-                        for g in pos
-                        if isinstance(lo, int) and isinstance(hi, int) and lo <= g <= hi
-                    ]
-                for g in ids:
-                    if g is not None:
-                        sets.setdefault(sid, []).append((self.grid(g, c, pos, "G"), comps))
-            elif c.name == "SPCADD":
-                adds[c.integer(1, "SID")] = [v for v in c.fields[2:] if isinstance(v, int)]
-        self.spc_sets = sorted(set(sets) | set(adds))
-        chosen = self.user_spc
-        if chosen is None:
-            picks = sorted(
-                {int(m.group(1)) for ln in self.case if (m := re.match(r"SPC\s*=\s*(\d+)", ln))}
-            )
-            if len(picks) > 1:
-                self.warnings.append(
-                    f"case control selects SPC sets {picks}; constraints from {picks[0]}"
-                )
-            chosen = picks[0] if picks else (self.spc_sets[0] if len(self.spc_sets) == 1 else None)
-        if chosen is None:
-            if self.spc_sets:
-                self.warnings.append(
-                    f"SPC sets {self.spc_sets} present, none selected: no constraints noted"
-                )
-            return []
-        if chosen not in sets and chosen not in adds:
-            raise InputError(
-                f"SPC set {chosen} is not defined", where=self.path, fix=f"defined: {self.spc_sets}"
-            )
-        members = adds.get(chosen, [chosen])
-        out: list[Constraint] = []
-        for sid in members:
-            out += [Constraint(n, comp) for n, comp in sets.get(sid, [])]
-        return out
-
 
 def grid_geometry(
     path: str | Path, ids: np.ndarray, *, missing_ok: bool = False
@@ -935,6 +796,7 @@ def load_bdf(
     *,
     wtmass: float | None = None,
     spc: int | None = None,
+    mpc: int | None = None,
     points: Sequence[ModalPoint] | None = None,
     coupled_mass: str | None = None,
 ) -> GraphModel:
@@ -953,6 +815,9 @@ def load_bdf(
         ``wtmass`` counts as given when it was declared, ``wtmass_given``, 1 included.)
     spc : int, optional
         SPC set noted as the model's constraints; default the case control's ``SPC = n``.
+    mpc : int, optional
+        MPC set applied (eliminated exactly); default the case control's ``MPC = n`` (none
+        selected: no MPC, as in NASTRAN).
     points : sequence of ModalPoint, optional
         Named points on grids (a points file, :func:`microg.models.modal.read_options`).
     coupled_mass : {"coupled", "coupled-nx9", "consistent"}, optional
@@ -996,7 +861,7 @@ def load_bdf(
     notes: list[str] = []
     cards, case = read_cards(path, notes)
     sc = Scales(system.length_m, system.force_N, system.time_s)
-    deck = _Deck(cards, case, str(path), sc, wtmass, spc)
+    deck = _Deck(cards, case, str(path), sc, wtmass, spc, mpc)
     deck.coupled_form = form
     deck.warnings.extend(notes)
     graph = deck.build()
@@ -1005,6 +870,12 @@ def load_bdf(
     out = []
     for p in points:
         node = f"grid:{p.grid}"
+        if p.grid in deck.spoint_ids:
+            raise InputError(
+                f"point {p.name!r}: {p.grid} is a scalar point (SPOINT), not a point in space",
+                where=str(path),
+                fix="name a grid",
+            )
         try:
             pos = graph.node(node).position
         except InputError as exc:

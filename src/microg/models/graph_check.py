@@ -11,6 +11,7 @@ reader (:mod:`microg.models.bdf`) call it on what they built, and
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 
@@ -57,6 +58,8 @@ def validate_graph(graph: GraphModel) -> None:
         ("rod", graph.rods),
         ("spring", graph.springs),
         ("scalar spring", graph.scalar_springs),
+        ("scalar mass", graph.scalar_masses),
+        ("multipoint constraint", graph.mpcs),
         ("mass", graph.masses),
         ("rigid link", graph.rigid_links),
         ("interpolation", graph.interpolations),
@@ -81,7 +84,9 @@ def validate_graph(graph: GraphModel) -> None:
     if not np.all(np.isfinite(pos)):
         bad = graph.nodes[int(np.flatnonzero(~np.isfinite(pos).all(axis=1))[0])].name
         raise InputError("position is not finite", where=f"{src}: {bad}")
-    scale = max(float(np.ptp(pos, axis=0).max()) if pos.shape[0] > 1 else 0.0, 1e-300)
+    scalar = {n.name for n in graph.nodes if n.scalar}
+    spatial = pos[[not n.scalar for n in graph.nodes]]
+    scale = max(float(np.ptp(spatial, axis=0).max()) if spatial.shape[0] > 1 else 0.0, 1e-300)
     try:
         axes = np.array([n.axes for n in graph.nodes], float).reshape(-1, 3, 3)
     except ValueError:
@@ -99,10 +104,29 @@ def validate_graph(graph: GraphModel) -> None:
                 fix=nearest_names(node, list(index)),
             )
 
+    def spatial_ref(node: str | None, where: str) -> None:
+        ref(node, where)
+        if node in scalar:
+            raise InputError(
+                f"{node!r} is a scalar point (SPOINT): it has no position or rotation",
+                where=f"{src}: {where}",
+                fix="connect a grid (a scalar point takes scalar elements and MPCs)",
+            )
+
+    def dof_ref(node: str, comp: Any, where: str) -> None:
+        ref(node, where)
+        top = 1 if node in scalar else 6
+        if not (isinstance(comp, int) and 1 <= comp <= top):
+            raise InputError(
+                f"component {comp!r} of {node!r} is not 1-{top}"
+                + (" (a scalar point has one)" if top == 1 else ""),
+                where=f"{src}: {where}",
+            )
+
     checked: set[int] = set()
     for b in graph.beams:
         for nd in b.nodes:
-            ref(nd, b.name)
+            spatial_ref(nd, b.name)
         s = b.section
         if id(s) not in checked:
             _check_section(s, f"{src}: {b.name}")
@@ -138,7 +162,7 @@ def validate_graph(graph: GraphModel) -> None:
             )
     for r in graph.rods:
         for nd in r.nodes:
-            ref(nd, r.name)
+            spatial_ref(nd, r.name)
         if not (math.isfinite(r.ea_N) and r.ea_N > 0 and r.gj_N_m2 >= 0):
             raise InputError("needs EA > 0 and GJ >= 0", where=f"{src}: {r.name}")
         if not r.mass_per_length_kg_per_m >= 0:
@@ -151,8 +175,8 @@ def validate_graph(graph: GraphModel) -> None:
                 fix="connect two distinct nodes, or use a spring (CBUSH/CELAS)",
             )
     for sp_ in graph.springs:
-        ref(sp_.nodes[0], sp_.name)
-        ref(sp_.nodes[1], sp_.name)
+        spatial_ref(sp_.nodes[0], sp_.name)
+        spatial_ref(sp_.nodes[1], sp_.name)
         for mat, what in ((sp_.stiffness, "stiffness"), (sp_.damping, "damping")):
             a = np.asarray(mat, float)
             if a.shape != (6, 6) or not np.all(np.isfinite(a)):
@@ -167,15 +191,34 @@ def validate_graph(graph: GraphModel) -> None:
     for cs in graph.scalar_springs:
         for d_ in cs.dofs:
             if d_ is not None:
-                ref(d_[0], cs.name)
-                if d_[1] not in range(1, 7):
-                    raise InputError(f"component {d_[1]} is not 1-6", where=f"{src}: {cs.name}")
+                dof_ref(d_[0], d_[1], cs.name)
         if cs.dofs[0] is None and cs.dofs[1] is None:
             raise InputError("connects nothing (both ends grounded)", where=f"{src}: {cs.name}")
         if not (math.isfinite(cs.stiffness) and math.isfinite(cs.damping)):
             raise InputError("stiffness and damping must be finite", where=f"{src}: {cs.name}")
+    for sm in graph.scalar_masses:
+        for d_ in sm.dofs:
+            if d_ is not None:
+                dof_ref(d_[0], d_[1], sm.name)
+        if sm.dofs[0] is None and sm.dofs[1] is None:
+            raise InputError("connects nothing (both ends grounded)", where=f"{src}: {sm.name}")
+        if not (math.isfinite(sm.mass) and sm.mass >= 0):
+            raise InputError(f"mass {sm.mass} must be finite and >= 0", where=f"{src}: {sm.name}")
+    for mp in graph.mpcs:
+        if not mp.terms:
+            raise InputError("has no term", where=f"{src}: {mp.name}")
+        for nd, comp, coef in mp.terms:
+            dof_ref(nd, comp, mp.name)
+            if not math.isfinite(coef):
+                raise InputError(f"coefficient {coef} is not finite", where=f"{src}: {mp.name}")
+        if mp.terms[0][2] == 0:
+            raise InputError(
+                "the first (dependent) term's coefficient is zero",
+                where=f"{src}: {mp.name}",
+                fix="give the dependent component a non-zero coefficient",
+            )
     for m in graph.masses:
-        ref(m.node, m.name)
+        spatial_ref(m.node, m.name)
         j = np.asarray(m.inertia_kg_m2, float)
         if not (math.isfinite(m.mass_kg) and m.mass_kg >= 0) or j.shape != (3, 3):
             raise InputError("needs a mass >= 0 and a 3x3 inertia", where=f"{src}: {m.name}")
@@ -191,31 +234,38 @@ def validate_graph(graph: GraphModel) -> None:
                 fix="check the signs of the products of inertia",
             )
     for rl in graph.rigid_links:
-        ref(rl.independent, rl.name)
+        spatial_ref(rl.independent, rl.name)
         for d in rl.dependents:
-            ref(d, rl.name)
+            spatial_ref(d, rl.name)
         if rl.independent in rl.dependents:
             raise InputError(
                 f"independent node {rl.independent!r} is also dependent", where=f"{src}: {rl.name}"
             )
         parse_components(rl.components, where=f"{src}: {rl.name}")
     for ip in graph.interpolations:
-        ref(ip.reference, ip.name)
+        spatial_ref(ip.reference, ip.name)
         parse_components(ip.components, where=f"{src}: {ip.name}")
         if not ip.sources:
             raise InputError("has no independent node", where=f"{src}: {ip.name}")
         for nd, comps, w in ip.sources:
-            ref(nd, ip.name)
-            parse_components(comps, where=f"{src}: {ip.name}", allowed="123")
+            spatial_ref(nd, ip.name)
+            parse_components(comps, where=f"{src}: {ip.name}")
             if not (math.isfinite(w) and w > 0):
                 raise InputError(f"weight {w} must be > 0", where=f"{src}: {ip.name}")
+        for nd, comps in ip.moved:
+            spatial_ref(nd, ip.name)
+            parse_components(comps, where=f"{src}: {ip.name}: UM")
     for p in graph.points:
-        ref(p.node, p.name)
+        spatial_ref(p.node, p.name)
         if p.kind not in ("crew", "experiment", "point"):
             raise InputError(f"unknown kind {p.kind!r}", where=f"{src}: {p.name}")
     for c in graph.constraints:
         ref(c.node, f"constraint on {c.node}")
-        parse_components(c.components, where=f"{src}: constraint on {c.node}")
+        parse_components(
+            c.components,
+            where=f"{src}: constraint on {c.node}",
+            allowed="1" if c.node in scalar else "123456",
+        )
 
 
 def _check_section(s: BeamSection, where: str) -> None:

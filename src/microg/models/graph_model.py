@@ -56,9 +56,11 @@ __all__ = [
     "GraphModel",
     "GraphPoint",
     "Interpolation",
+    "MultiPointConstraint",
     "Node",
     "RigidLink",
     "RodElement",
+    "ScalarMass",
     "ScalarSpring",
     "Spring",
     "default_orientation",
@@ -100,24 +102,29 @@ PARALLEL_TOL = 1e-6
 
 @dataclass(frozen=True)
 class Node:
-    """A node (NASTRAN GRID): 6 degrees of freedom.
+    """A node (NASTRAN GRID): 6 degrees of freedom; or a scalar point (SPOINT): one.
 
     Attributes
     ----------
     name : str
-        ``"grid:101"`` for NASTRAN grid 101.
+        ``"grid:101"`` for NASTRAN grid 101, ``"spoint:7"`` for scalar point 7.
     position : ndarray (3,)
-        Basic frame, m.
+        Basic frame, m.  A scalar point is not a point in space: its position (zero) is
+        never used, and it is neither a sample nor an observable point.
     axes : ndarray (3, 3)
         Rows: directions of components 1-3 (and of rotations 4-6) in the basic frame.
     frame : str
         Name of the frame the axes come from (``"basic"``).
+    scalar : bool
+        A scalar point: its one DOF is component 1 (NASTRAN's component 0 or blank), which
+        moves with no rigid-body motion.
     """
 
     name: str
     position: np.ndarray
     axes: np.ndarray = field(default_factory=lambda: np.eye(3))
     frame: str = "basic"
+    scalar: bool = False
 
 
 @dataclass(frozen=True)
@@ -274,6 +281,50 @@ class ScalarSpring:
 
 
 @dataclass(frozen=True)
+class ScalarMass:
+    """A scalar mass between two node components (NASTRAN CMASS1/CMASS2).
+
+    Its mass matrix is ``m (e_b - e_a)(e_b - e_a)^T`` on the two components (NASTRAN's scalar
+    element form, the same as a scalar spring's); one end grounded leaves ``m`` on the
+    other.
+
+    Attributes
+    ----------
+    name : str
+    dofs : ((str, int) or None, (str, int) or None)
+        (node, component 1-6 along the node's axes; 1 for a scalar point); None: grounded.
+    mass : float
+        kg (translations, scalar points), kg m^2 (rotations), kg m between a translation and
+        a rotation.
+    """
+
+    name: str
+    dofs: tuple[tuple[str, int] | None, tuple[str, int] | None]
+    mass: float
+
+
+@dataclass(frozen=True)
+class MultiPointConstraint:
+    """A linear constraint among node components (NASTRAN MPC): ``sum_j a_j u_j = 0``.
+
+    The first term's component is dependent and eliminated exactly,
+    ``u_1 = -sum_{j>1} (a_j / a_1) u_j`` (NASTRAN's rule).
+
+    Attributes
+    ----------
+    name : str
+        ``"mpc:3#1"``: set 3, its first equation.
+    terms : tuple of (str, int, float)
+        (node, component 1-6 along the node's axes (1 for a scalar point), coefficient); the
+        coefficients are in the model's units (SI: a rotation's per rad, a translation's per
+        m), so that the equation is homogeneous.
+    """
+
+    name: str
+    terms: tuple[tuple[str, int, float], ...]
+
+
+@dataclass(frozen=True)
 class ConcentratedMass:
     """A rigid mass attached to a node (NASTRAN CONM2).
 
@@ -320,23 +371,28 @@ class Interpolation:
     """An interpolation element (NASTRAN RBE3): a reference node follows a weighted average.
 
     The reference node's motion is the rigid-body motion that best fits (weighted least
-    squares) the motion of the independent nodes' components; it adds no stiffness.
+    squares, :func:`microg.structure.elements.interpolation_matrix`) the motion of the
+    independent nodes' components; it adds no stiffness.
 
     Attributes
     ----------
     name : str
     reference : str
-        The dependent (reference) node.
+        The reference node.
     components : str
-        Its dependent components.
+        Its components the fit sets (NASTRAN REFC).
     sources : tuple of (str, str, float)
-        (node, translational components among ``"123"``, weight > 0) of each independent.
+        (node, components among ``"123456"``, weight > 0) of each independent.
+    moved : tuple of (str, str)
+        NASTRAN UM: (node, components) that are dependent instead of the reference's
+        components (as many in all); empty: the reference's components are dependent.
     """
 
     name: str
     reference: str
     components: str
     sources: tuple[tuple[str, str, float], ...]
+    moved: tuple[tuple[str, str], ...] = ()
 
 
 @dataclass(frozen=True)
@@ -378,6 +434,9 @@ class GraphModel:
     nodes : tuple of Node
     beams, rods, springs, scalar_springs, masses, rigid_links, interpolations : tuples
         The elements.
+    scalar_masses : tuple of ScalarMass
+    mpcs : tuple of MultiPointConstraint
+        Multipoint constraints (NASTRAN MPC), eliminated exactly.
     points : tuple of GraphPoint
     frames : tuple of CoordinateFrame
         The coordinate systems the model was written in (for reference).
@@ -399,6 +458,8 @@ class GraphModel:
     masses: tuple[ConcentratedMass, ...] = ()
     rigid_links: tuple[RigidLink, ...] = ()
     interpolations: tuple[Interpolation, ...] = ()
+    scalar_masses: tuple[ScalarMass, ...] = ()
+    mpcs: tuple[MultiPointConstraint, ...] = ()
     points: tuple[GraphPoint, ...] = ()
     frames: tuple[CoordinateFrame, ...] = ()
     mass_formulation: str = "consistent"

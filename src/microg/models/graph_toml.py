@@ -92,7 +92,8 @@ def dump_graph(graph: GraphModel) -> str:
     Parameters
     ----------
     graph : GraphModel
-        Any graph model without scalar springs or coupled 6x6 spring terms.
+        Any graph model without scalar springs, scalar masses, scalar points, MPCs, RBE3 UM
+        or rotational RBE3 sources, or coupled 6x6 spring terms (each refused).
     """
     lines = [
         "[graph]",
@@ -198,6 +199,18 @@ def dump_graph(graph: GraphModel) -> str:
         ]
     if graph.scalar_springs:
         raise InputError("scalar springs (CELAS) have no graph TOML form; keep the deck")
+    for what, present in (
+        ("scalar masses (CMASS)", bool(graph.scalar_masses)),
+        ("multipoint constraints (MPC)", bool(graph.mpcs)),
+        ("scalar points (SPOINT)", any(n.scalar for n in graph.nodes)),
+        ("RBE3 UM components", any(ip.moved for ip in graph.interpolations)),
+        (
+            "RBE3 rotational independent components",
+            any(set(c) & set("456") for ip in graph.interpolations for _, c, _ in ip.sources),
+        ),
+    ):
+        if present:
+            raise InputError(f"{what} have no graph TOML form; keep the deck")
     for m in graph.masses:
         j = m.inertia_kg_m2
         inertia = ", ".join(

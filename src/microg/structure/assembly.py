@@ -1,7 +1,7 @@
 """Assembly of a graph model's element matrices on 6 basic-frame DOFs per node.
 
 :func:`assemble_frame` evaluates the element kernels (:mod:`microg.structure.elements`) of
-every beam, rod, spring, scalar spring and concentrated mass of a
+every beam, rod, spring, scalar spring, scalar mass and concentrated mass of a
 :class:`~microg.models.graph_model.GraphModel`, rotates them to the basic frame (beam end
 offsets as rigid links, skew sections about their principal axes, pin flags released) and
 sums them into sparse stiffness, mass and damping matrices (the g-set); the rigid elements
@@ -69,6 +69,10 @@ class FrameMatrices:
         bending axes of a skewed section), in the order of ``graph.beams``.
     beam_length : ndarray (nb,)
         Length of each beam element between its (offset) ends, m.
+    working : sparse CSR (6 nn, 6 nn) or None
+        ``u_basic = working @ u_work``: the independent DOFs of the nodes
+        :func:`~microg.structure.links.turned_nodes` picks are along their own axes; None:
+        every independent DOF is a basic-frame one.
     """
 
     stiffness: sp.csr_matrix
@@ -81,6 +85,7 @@ class FrameMatrices:
     independent: np.ndarray
     beam_rotation: np.ndarray = field(default_factory=lambda: np.zeros((0, 3, 3)))
     beam_length: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    working: sp.csr_matrix | None = None
 
 
 def _coo(
@@ -287,6 +292,28 @@ def assemble_frame(graph: GraphModel, *, mass: str | None = None) -> FrameMatric
             _scatter(d[None], s.structural_damping * kb[None], rg, cg, vg)
 
     nodes = graph.nodes
+
+    def scalar_vector(dofs: tuple[tuple[str, int] | None, ...]) -> tuple[np.ndarray, np.ndarray]:
+        """DOFs and ``e_b - e_a`` of a scalar element's two components.
+
+        A scalar point's one DOF is slot 0 of its node.
+        """
+        dl: list[np.ndarray] = []
+        vl: list[np.ndarray] = []
+        for end, dof in enumerate(dofs):
+            if dof is None:
+                continue
+            i = index[dof[0]]
+            c = dof[1] - 1
+            v = np.zeros(6)
+            v[3 * (c // 3) : 3 * (c // 3) + 3] = nodes[i].axes[c % 3]
+            dl.append(6 * i + np.arange(6))
+            vl.append(v if end else -v)
+        return np.concatenate(dl), np.concatenate(vl)
+
+    for sm in graph.scalar_masses:
+        d, v = scalar_vector(sm.dofs)
+        _scatter(d[None], (sm.mass * np.outer(v, v))[None], rm, cm, vm)
     for cs in graph.scalar_springs:
         dl: list[np.ndarray] = []
         vl: list[np.ndarray] = []
@@ -321,5 +348,7 @@ def assemble_frame(graph: GraphModel, *, mass: str | None = None) -> FrameMatric
     M = _coo(rm, cm, vm, n)
     C = _coo(rc, cc, vc, n)
     G = _coo(rg, cg, vg, n)
-    T, ind = link_transform(graph, P, index)
-    return FrameMatrices(K, M, C, G, P, tuple(nd.name for nd in nodes), T, ind, beam_R, beam_L)
+    T, ind, working = link_transform(graph, P, index)
+    return FrameMatrices(
+        K, M, C, G, P, tuple(nd.name for nd in nodes), T, ind, beam_R, beam_L, working
+    )

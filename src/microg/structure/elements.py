@@ -632,14 +632,20 @@ def interpolation_matrix(
     directions: np.ndarray,
     weights: np.ndarray,
     *,
+    rotational: np.ndarray | None = None,
+    length_m: float | None = None,
     where: str = "interpolation",
 ) -> np.ndarray:
-    """RBE3: the reference point's 6 DOFs from independent translation components.
+    """RBE3: the reference point's 6 DOFs from independent components (NASTRAN's fit).
 
     The reference motion ``q`` (translation and rotation at ``reference``) minimises
-    ``sum_k w_k (e_k . (u_k - q_t - q_r x d_k))^2`` with ``d_k`` the source position minus
-    the reference, i.e. ``q = (S^T W S)^-1 S^T W s`` where ``s_k = e_k . u_k`` are the source
-    components and ``S_k = e_k^T [I, -[d_k]x]``.  A rigid motion of the sources is returned
+    ``sum_k w_k (S_k q - s_k)^2`` over the independent components ``s_k``: a translation
+    component ``s_k = e_k . u_k`` has ``S_k = [e_k, d_k x e_k]`` (``e_k . (q_t + q_r x d_k)``,
+    ``d_k`` the source position minus the reference), a rotation component
+    ``s_k = e_k . theta_k`` has ``S_k = [0, e_k]`` and its weight multiplied by ``L_c^2``, the
+    square of the mean distance from the reference to the independent grids (MSC/NX Quick
+    Reference Guide, RBE3 remarks; pyyeti's ``n2p.formrbe3``, checked there against NX 9's
+    GM matrix).  So ``q = (S^T W S)^-1 S^T W s``; a rigid motion of the sources is returned
     exactly.
 
     Parameters
@@ -649,9 +655,18 @@ def interpolation_matrix(
     positions : ndarray (k, 3)
         Position of the node of each source component, m.
     directions : ndarray (k, 3)
-        Unit direction of each source component (basic frame).
+        Unit direction of each source component (basic frame): a translation's, or the axis
+        of a rotation's.
     weights : ndarray (k,)
-        > 0.
+        > 0 (NASTRAN WTi, dimensionless: translations and rotations alike).
+    rotational : ndarray (k,) of bool, optional
+        Which components are rotations (default none).
+    length_m : float, optional
+        ``L_c``, m: the mean distance from ``reference`` to the independent grids, each grid
+        counted once (a grid coincident with the reference counts as 0); default the mean
+        over the distinct ``positions``.  Used only when a rotation is among the sources.
+    where : str
+        The element, for errors.
 
     Returns
     -------
@@ -660,11 +675,28 @@ def interpolation_matrix(
     """
     d = np.asarray(positions, float) - np.asarray(reference, float)
     e = np.asarray(directions, float)
-    w = np.asarray(weights, float)
+    w = np.asarray(weights, float).copy()
+    rot = np.zeros(w.size, bool) if rotational is None else np.asarray(rotational, bool)
     S = np.concatenate([e, np.cross(d, e)], axis=1)  # e.(q_t + q_r x d) = e.q_t + (d x e).q_r
+    if rot.any():
+        S[rot, :3] = 0.0
+        S[rot, 3:] = e[rot]
+        if length_m is None:
+            grids = np.unique(np.asarray(positions, float), axis=0)
+            length_m = float(np.linalg.norm(grids - np.asarray(reference, float), axis=1).mean())
+        if length_m > 1e-12:  # NASTRAN (and pyyeti) scale only a non-zero length
+            w[rot] *= length_m**2
     N = S.T @ (w[:, None] * S)
-    scale = float(np.max(np.abs(np.diag(N)))) or 1.0
-    if np.linalg.cond(N / scale) > INTERPOLATION_COND_MAX:
+    diag = np.diag(N).copy()
+    if not np.all(diag > 0):
+        raise InputError(
+            "its independent components do not determine the reference's six motions "
+            f"(none acts on reference DOF {int(np.flatnonzero(~(diag > 0))[0]) + 1})",
+            where=where,
+            fix="add independent nodes or components",
+        )
+    js = 1.0 / np.sqrt(diag)  # Jacobi scaling: the test is independent of units and weights
+    if np.linalg.cond(N * np.outer(js, js)) > INTERPOLATION_COND_MAX:
         raise InputError(
             "its independent components do not determine the reference's six motions "
             "(too few nodes, or collinear ones)",

@@ -55,7 +55,7 @@ from microg.structure.elements import (
     rod_stiffness_local,
     shear_parameter,
 )
-from microg.structure.links import basic_dofs
+from microg.structure.links import basic_dofs, turned_nodes
 from microg.structure.mesh import (
     AXIAL_PENALTY,
     DEFAULT_ELEMENTS_PER_BEAM,
@@ -86,6 +86,7 @@ __all__ = [
     "frame_stiffness_local",
     "mass_properties_of",
     "mesh_station",
+    "rigid_rows",
     "point_mass_matrix",
     "rigid_link",
     "torsion_is_rigid",
@@ -182,15 +183,29 @@ class _PointMaps(Mapping[str, PointMap]):
     (modal-mass peaks) does not build a dense map per node of a large model.
     """
 
-    def __init__(self, named: dict[str, PointMap], build_node: Any, node_names: set[str]):
+    def __init__(
+        self,
+        named: dict[str, PointMap],
+        build_node: Any,
+        node_names: set[str],
+        scalar_names: set[str] | frozenset[str] = frozenset(),
+    ):
         self._named = named
         self._build = build_node
         self._nodes = node_names
+        self._scalar = scalar_names
         self._cache: dict[str, PointMap] = {}
 
     def __getitem__(self, key: str) -> PointMap:
         if key in self._named:
             return self._named[key]
+        if key in self._scalar:
+            raise InputError(
+                f"{key!r} is a scalar point (SPOINT), not a point in space: it has no "
+                "position and no acceleration to observe",
+                where=key,
+                fix="observe a grid",
+            )
         if key in self._nodes:
             if key not in self._cache:
                 self._cache[key] = self._build(key)
@@ -198,7 +213,8 @@ class _PointMaps(Mapping[str, PointMap]):
         raise KeyError(key)
 
     def __contains__(self, key: object) -> bool:
-        return key in self._named or key in self._nodes
+        # a scalar point is "in" so that looking it up says why it cannot be observed
+        return key in self._named or key in self._nodes or key in self._scalar
 
     def __iter__(self) -> Iterator[str]:
         return iter(self._named)
@@ -227,8 +243,46 @@ def _mass_props(M: Any, r: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
     return total, cm, 0.5 * (inertia + inertia.T)
 
 
+def rigid_rows(
+    positions: np.ndarray,
+    point: np.ndarray,
+    scalar: np.ndarray | None = None,
+    basis: Any = None,
+) -> np.ndarray:
+    """Exact rigid-body vectors (6 nn, 6) about ``point`` on the working DOFs of the nodes.
+
+    Unit translations and small rotations of every node, ``u = t + theta x (x - point)``;
+    zero on scalar points (they take no part in rigid-body motion, as in NASTRAN's rigid-body
+    geometry); turned to the nodes' own axes where ``basis`` (``u_basic = basis u_work``,
+    :attr:`~microg.structure.assembly.FrameMatrices.working`) says so.
+
+    Parameters
+    ----------
+    positions : ndarray (nn, 3)
+        Node positions, m.
+    point : ndarray (3,)
+        The rotations' centre, m.
+    scalar : ndarray (nn,) of bool, optional
+        Scalar points.
+    basis : sparse (6 nn, 6 nn), optional
+        Orthonormal: ``u_work = basis^T u_basic``.
+    """
+    r = rigid_link(np.asarray(positions, float) - point).reshape(-1, 6)
+    if scalar is not None and np.any(scalar):
+        rows = np.flatnonzero(np.repeat(np.asarray(scalar, bool), 6))
+        r[rows] = 0.0
+    if basis is not None:
+        r = np.asarray(basis.T @ r)
+    return r
+
+
 def mass_properties_of(
-    M: Any, positions: np.ndarray, dofs: np.ndarray | None = None
+    M: Any,
+    positions: np.ndarray,
+    dofs: np.ndarray | None = None,
+    *,
+    scalar: np.ndarray | None = None,
+    basis: Any = None,
 ) -> tuple[float, np.ndarray, np.ndarray]:
     """Total mass (kg), centre of mass (m) and inertia about it (kg m^2) of a frame model.
 
@@ -244,13 +298,18 @@ def mass_properties_of(
         Node positions, m.
     dofs : ndarray of int, optional
         The node DOFs (``6 node + k``) the coordinates are (default: all, in order).
+    scalar : ndarray (nn,) of bool, optional
+        Scalar points (no rigid-body motion, no position).
+    basis : sparse (6 nn, 6 nn), optional
+        The working DOFs of :func:`rigid_rows` (``dofs`` index them).
     """
     P = np.asarray(positions, float)
     sel = slice(None) if dofs is None else np.asarray(dofs)
-    c0 = P.mean(axis=0) if P.size else np.zeros(3)
-    total, d, _ = _mass_props(M, rigid_link(P - c0).reshape(-1, 6)[sel])
+    spatial = P if scalar is None else P[~np.asarray(scalar, bool)]
+    c0 = spatial.mean(axis=0) if spatial.size else np.zeros(3)
+    total, d, _ = _mass_props(M, rigid_rows(P, c0, scalar, basis)[sel])
     cm = c0 + d
-    total, d2, inertia = _mass_props(M, rigid_link(P - cm).reshape(-1, 6)[sel])
+    total, d2, inertia = _mass_props(M, rigid_rows(P, cm, scalar, basis)[sel])
     return total, cm + d2, inertia
 
 
@@ -301,13 +360,25 @@ def build_frame(
             "not applied: this is the free-free structure (constrained=True, or --constrained, "
             "applies them, as a clamped NASTRAN run does)"
         )
+    scalar = np.array([nd.scalar for nd in graph.nodes], bool)
+    pos_ind = np.full(T.shape[0], -1)
+    pos_ind[fm.independent] = np.arange(fm.independent.size)
+    # a scalar point has one DOF: the other five slots of its node are not coordinates
+    for si in np.flatnonzero(scalar):
+        for k in range(1, 6):
+            if pos_ind[6 * si + k] >= 0:
+                keep[pos_ind[6 * si + k]] = False
     if constrained:
         index = graph.node_index()
-        pos_ind = np.full(T.shape[0], -1)
-        pos_ind[fm.independent] = np.arange(fm.independent.size)
+        turned = turned_nodes(graph)
         for c in graph.constraints:
             i = index[c.node]
-            for k in basic_dofs(graph.nodes[i], c.components, where=f"constraint on {c.node}"):
+            ks = (
+                [int(ch) - 1 for ch in c.components]
+                if turned[i]
+                else basic_dofs(graph.nodes[i], c.components, where=f"constraint on {c.node}")
+            )
+            for k in ks:
                 j = pos_ind[6 * i + k]
                 if j < 0:
                     raise InputError(
@@ -328,7 +399,15 @@ def build_frame(
     keep &= ~unconnected
     live = np.flatnonzero(keep)
     names = fm.names
-    ind_labels = [f"{names[d // 6]}:{DOF_NAMES[d % 6]}" for d in fm.independent]
+    along = turned_nodes(graph) if fm.working is not None else np.zeros(len(names), bool)
+    ind_labels = [
+        names[d // 6]
+        if scalar[d // 6]
+        else f"{names[d // 6]}:{d % 6 + 1}"
+        if along[d // 6]
+        else f"{names[d // 6]}:{DOF_NAMES[d % 6]}"
+        for d in fm.independent
+    ]
     # massless directions: zero rows, and null directions of small coupled mass blocks
     # (a node whose lumped torsional inertias span fewer than three axes)
     Q, null, ind_labels = _mass_basis(Mn, live, ind_labels)
@@ -399,12 +478,18 @@ def build_frame(
     # the origin, whose rounding would cancel in the shift to the centre of mass)
     P = fm.positions
     total, cm, inertia = mass_properties_of(
-        fm.transform.T @ fm.mass @ fm.transform, P, fm.independent
+        fm.transform.T @ fm.mass @ fm.transform,
+        P,
+        fm.independent,
+        scalar=scalar,
+        basis=fm.working,
     )
     # rigid-body vectors: exact unit motions about the centre of mass (lever arms formed once,
     # as microg.structure.fem does), restricted to the retained coordinates
-    r_ind = rigid_link(P - cm).reshape(-1, 6)[fm.independent]
+    r_ind = rigid_rows(P, cm, scalar, fm.working)[fm.independent]
     r_ret = (r_ind if Q is None else np.asarray(Q.T @ r_ind))[retained]
+    if scalar.any():
+        r_ret = _scalar_rigid(K_out, r_ret, labels)
     rigid = (
         {}
         if constrained and applied
@@ -415,7 +500,12 @@ def build_frame(
 
     node_map = _NodeMap(graph.node_index(), P, T, retained, massless, X, n_ind)
     named = {p.name: _named_map(node_map, p) for p in graph.points}
-    points = _PointMaps(named, node_map, {nd.name for nd in graph.nodes})
+    points = _PointMaps(
+        named,
+        node_map,
+        {nd.name for nd in graph.nodes if not nd.scalar},
+        {nd.name for nd in graph.nodes if nd.scalar},
+    )
     meta = {
         "model": graph.name,
         "source": graph.source,
@@ -453,6 +543,48 @@ def build_frame(
         samples=samples,
         meta=meta,
     )
+
+
+def _scalar_rigid(K: Any, r: np.ndarray, labels: tuple[str, ...]) -> np.ndarray:
+    """Rigid-body vectors carried onto the scalar points their elements tie to the grids.
+
+    A scalar point takes no part in rigid-body motion by itself (NASTRAN's rigid-body
+    geometry is zero there), but one tied by springs to grid components moves with them: its
+    motion is the static solution ``K_ss s = -K_sg r_g``.  When the extended vector is in
+    the null space of K, it is the exact rigid-body mode; when it is not (a scalar point
+    also grounded), the solver's test of ``K r`` rejects it as before.  A singular ``K_ss``
+    (a scalar point without stiffness) leaves the vectors as they are.
+
+    Parameters
+    ----------
+    K : ndarray or sparse (n, n)
+        Stiffness on the coordinates.
+    r : ndarray (n, 6)
+        Rigid-body vectors (zero at the scalar points).
+    labels : tuple of str
+        Coordinate labels: a scalar point's is its node name (``"spoint:7"``).
+    """
+    import scipy.sparse as sp
+    import scipy.sparse.linalg as spla
+
+    sc = np.array([lab.startswith("spoint:") and lab.count(":") == 1 for lab in labels], bool)
+    if not sc.any():
+        return r
+    Ks = sp.csr_matrix(K)
+    s_idx, g_idx = np.flatnonzero(sc), np.flatnonzero(~sc)
+    rhs = -np.asarray(Ks[s_idx][:, g_idx] @ r[g_idx])
+    if not np.any(rhs):
+        return r
+    try:
+        lu = spla.splu(sp.csc_matrix(Ks[s_idx][:, s_idx]))
+        piv = np.abs(lu.U.diagonal())
+        if piv.min() <= 1e-12 * piv.max():
+            return r
+        out = r.copy()
+        out[s_idx] = lu.solve(rhs)
+    except RuntimeError:
+        return r
+    return out
 
 
 #: coupled mass blocks up to this many DOFs are checked for massless directions
@@ -623,8 +755,10 @@ def _samples(
     live = np.zeros(n_ind, bool)
     live[retained] = True
     live[massless] = True
-    # a node is a sample if some DOF of it depends on a live coordinate
+    # a node is a sample if some DOF of it depends on a live coordinate (a scalar point is
+    # not a point in space: never a sample)
     reach = np.asarray(abs(T) @ live.astype(float)).reshape(-1, 6).sum(axis=1) > 0
+    reach &= ~np.array([nd.scalar for nd in graph.nodes], bool)
     nodes = [int(i) for i in np.flatnonzero(reach)]
     offs = [np.zeros(3)] * len(nodes)
     labels = [names[i] for i in nodes]
