@@ -13,7 +13,16 @@ from typing import Any
 import click
 
 from microg import defaults
-from microg.cli._common import Option, discretisation_options, given, num, preset_option, written
+from microg.cli._common import (
+    MODEL_FILE_FLAGS,
+    Option,
+    discretisation_options,
+    given,
+    model_file_options,
+    num,
+    preset_option,
+    written,
+)
 from microg.cli.params import Integer, PathType, PositiveFloat
 
 __all__ = ["modes"]
@@ -26,8 +35,8 @@ FLAGS = {
     "units": "--units",
     "wtmass": "--wtmass",
     "points": "--points",
-    "subcase": "--subcase",
     "constrained": "--constrained",
+    **MODEL_FILE_FLAGS,
 }
 
 
@@ -93,12 +102,7 @@ def _effective_percent(m: Any) -> dict[str, Any]:
     default=None,
     help="Also write the modes as UFF datasets 15+55 (+164 units) to this file.",
 )
-@click.option(
-    "--subcase",
-    type=click.IntRange(min=1),
-    default=None,
-    help="An OP2 with modes of several subcases: the subcase to read.",
-)
+@model_file_options
 @click.option(
     "--constrained",
     is_flag=True,
@@ -119,6 +123,7 @@ def modes(
     points: Path | None,
     uff_out: Path | None,
     subcase: int | None,
+    superelement: int | None,
     constrained: bool,
     as_json: bool,
 ) -> None:
@@ -144,7 +149,13 @@ def modes(
         raise InputError("applies to --method ritz only", where="--functions")
     if uff_out is not None:  # before any work: a file that cannot be written is bad input
         uff_out = check_writable(uff_out, where="--uff", directory=False)
-    reader = (("units", units), ("wtmass", wtmass), ("points", points), ("subcase", subcase))
+    reader = (
+        ("units", units),
+        ("wtmass", wtmass),
+        ("points", points),
+        ("subcase", subcase),
+        ("superelement", superelement),
+    )
     options = {k: v for k, v in reader if v is not None}
     with flag_errors(FLAGS):
         mdl = microg.load_model(model, **options)
