@@ -65,7 +65,8 @@ def test_dof_tables_match_pyyeti_for_every_superelement():
             )
             xyz = u[["x", "y", "z"]].values
             np.testing.assert_array_equal(t.xyz[t.kinds == 1], xyz[idx[:, 1] == 1])
-            for k, r in zip(np.flatnonzero(t.kinds == 1), np.flatnonzero(idx[:, 1] == 1)):
+            gr, rr = np.flatnonzero(t.kinds == 1), np.flatnonzero(idx[:, 1] == 1)
+            for k, r in zip(gr, rr, strict=True):
                 assert t.cd[k] == int(xyz[r + 1, 0])
                 if t.cd[k]:
                     frame = t.coords[int(t.cd[k])]
