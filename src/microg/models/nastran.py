@@ -487,6 +487,15 @@ def modal_model_from_op4(
     kaa = op4m.get(stiffness).astype(float)
     if maa.shape != kaa.shape or maa.ndim != 2 or maa.shape[0] != maa.shape[1]:
         raise InputError(f"{mass} and {stiffness} must be square of one size", where=op4m.path)
+    for name, a in ((mass, maa), (stiffness, kaa)):
+        top = float(np.abs(a).max()) if a.size else 0.0
+        if top and float(np.abs(a - a.T).max()) > SYMMETRY_TOL * top:
+            raise InputError(
+                f"{name} is not symmetric (largest |A - A^T| is "
+                f"{float(np.abs(a - a.T).max()) / top:.2g} of its largest entry)",
+                where=op4m.path,
+                fix="give the a-set mass and stiffness of the run (is the file corrupt?)",
+            )
     rec = op4m.get(shapes).astype(float) if shapes else np.eye(maa.shape[0])
     if rec.ndim != 2 or rec.shape[1] != maa.shape[0]:
         raise InputError(
@@ -578,6 +587,9 @@ def modal_model_from_op4(
     )
 
 
+#: MAA/KAA asymmetry accepted, relative to the largest entry (NASTRAN's round-off: 6e-16 in
+#: the real files of tests/data/nastran); more is a corrupt or foreign matrix, never averaged
+SYMMETRY_TOL = 1e-9
 #: a direction of the a-set whose mass is below this fraction of the largest is massless
 MASSLESS_TOL = 1e-12
 
