@@ -4,8 +4,10 @@
 :func:`microg.models.bdf.grid_geometry`, gives the geometry an OP2 lacks) and converts it
 to SI with the user's unit declaration (:func:`microg.models.file_units.parse_units`).
 
-OP4 matrices (MAA, KAA, a mode-shape/recovery matrix) are read by pyyeti's OP4 reader
-(numpy 2 ready), imported lazily: without it, one line names the extra.
+OP4 matrices (MAA, KAA or EXTSEOUT's MXX, KXX, a recovery matrix) are read by pyyeti's OP4
+reader (numpy 2 ready), imported lazily: without it, one line names the extra.  Every
+matrix is kept, duplicated names included (:class:`Op4Model`: ``NAME#k``, nas2cam's
+SE_START blocks by superelement); the rows' DOFs come from :mod:`microg.models.dofmap`.
 """
 
 from __future__ import annotations
@@ -243,6 +245,8 @@ def _run_wtmass(op2: Op2Modes, units: UnitSystem) -> float:
 #: the a-set mass and stiffness names tried, in order: the nas2cam DMAP's and EXTSEOUT's
 OP4_MASS_NAMES = ("MAA", "MXX")
 OP4_STIFFNESS_NAMES = ("KAA", "KXX")
+#: the most entries of one OP4 matrix read (dense, 8 bytes each: 400 MB; an a-set of 7,000)
+MAX_OP4_ENTRIES = 50_000_000
 #: the marker matrix that starts each superelement's matrices (pyyeti's nas2cam DMAP)
 SE_START = "SE_START"
 
@@ -358,7 +362,20 @@ def read_op4(path: str | Path) -> Op4Model:
     try:
         with _w.catch_warnings():
             _w.simplefilter("ignore")
+            # sizes first (headers only): a corrupt header must not allocate a huge matrix
+            heads = op4.dir(label, verbose=False)
+            for name, dims in zip(heads[0], heads[1], strict=True):
+                r, c = (int(v) for v in dims)
+                if r < 0 or c < 0 or r * c > MAX_OP4_ENTRIES:
+                    raise InputError(
+                        f"matrix {str(name).upper()} is {r} x {c}: more than "
+                        f"{MAX_OP4_ENTRIES:.0e} entries (a corrupt header?)",
+                        where=label,
+                        fix="give the a-set matrices of the run",
+                    )
             names, mats, *_ = op4.read(label, into="list", sparse=False)
+    except InputError:
+        raise
     except Exception as exc:  # pyyeti raises bare errors on corrupt files
         raise InputError(
             f"truncated or corrupt OP4: {type(exc).__name__}: {_first_line(exc)}",
