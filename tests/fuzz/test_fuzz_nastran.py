@@ -232,3 +232,9 @@ def test_cli_gives_one_line_and_exit_2_on_a_cut_file(seed: str, tmp_path: Path) 
     assert rc == 2, out.getvalue() + err.getvalue()
     assert one_line(err.getvalue()) and out.getvalue() == ""
     assert seed in err.getvalue()  # names the file
+
+
+def test_include_with_a_nul_byte_is_one_line() -> None:
+    # found by this fuzzer: a NUL in an INCLUDE's name made os.path raise ValueError
+    deck = (DATA / "nas2cam_no_se.dat").read_text().replace("nx_dmaps", "\x00", 1)
+    assert check("nas2cam_no_se.dat", "field", deck.encode()) == "clean error"

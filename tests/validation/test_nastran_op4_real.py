@@ -217,3 +217,22 @@ def test_scalar_points_in_the_csv_fallback(tmp_path):
     assert "DOF map file" in m.meta["dof_map"]
     # the csv has no output systems: grid 11's rotations differ, the frequencies do not
     np.testing.assert_allclose(m.omega, ref.omega, rtol=1e-12, atol=0)
+
+
+@pytest.mark.parametrize("name", ["extseout_inboard.op2", "csuper_assemble.op2"])
+def test_eqexin_and_bgpdt_match_pynastran(name):
+    """EQEXINS and BGPDTS of SOL 103 OP2s (no USET) as pyNastran 1.4.1 reads them, exactly
+    (pyNastran cannot open the nas2cam DMAP's OP2s: their header says DBWRITE)."""
+    pytest.importorskip("pyNastran")
+    from pyNastran.op2.op2 import OP2
+
+    from microg.models.op2 import read_op2_dof_tables
+
+    o = OP2(debug=None)
+    o.read_op2(str(DATA / name), build_dataframe=False)
+    eq, bg = o.op2_results.eqexin, o.op2_results.bgpdt
+    t = [x for x in read_op2_dof_tables(DATA / name) if "EQEXINS" in x.tables][-1]
+    order = np.argsort(eq.dof)  # pyNastran keeps EQEXIN's external order; SIL sorts it
+    np.testing.assert_array_equal(eq.nid[order], t.ids)
+    np.testing.assert_array_equal(eq.doftype[order], t.kinds)
+    np.testing.assert_array_equal(np.asarray(bg.xyz), t.xyz)

@@ -168,6 +168,12 @@ def _read_lines(
                     fix="write INCLUDE 'file.bdf'",
                 )
             name = m.group(1).strip()
+            if any(ord(ch) < 32 for ch in name):  # a NUL is no path (os raises ValueError)
+                raise InputError(
+                    "INCLUDE file name holds a control character",
+                    where=f"{shown}:{number}",
+                    fix="write INCLUDE 'file.bdf'",
+                )
             target = Path(name) if Path(name).is_absolute() else path.parent / name
             target_shown = str(Path(shown).parent / name) if not Path(name).is_absolute() else name
             if depth >= MAX_INCLUDE_DEPTH or target.resolve() in stack:
