@@ -40,9 +40,7 @@ def path(value: Any, name: str) -> Path:
     return Path(value)
 
 
-def integer(
-    value: Any, name: str, *, lo: int | None = None, hi: int | None = None
-) -> int:
+def integer(value: Any, name: str, *, lo: int | None = None, hi: int | None = None) -> int:
     """An integer (Python or numpy; not bool, not a float) within ``[lo, hi]``."""
     if isinstance(value, bool) or not isinstance(value, numbers.Integral):
         raise InputError(f"must be an integer, got {_kind(value)}", where=name)

@@ -9,6 +9,9 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+from pathlib import Path
+
+import pytest
 
 from microg.models.load import loads_station
 
@@ -57,3 +60,26 @@ def test_which_models_are_stations():
     assert loads_station("ioc") and loads_station("station.toml")  # shipped name, TOML
     assert not loads_station("modes.npz") and not loads_station("run.op2")
     assert not loads_station("ioc", points="points.toml")  # a points file: a modal model's
+
+
+def test_op4_superelement_and_its_dof_map_in_the_output(capsys):
+    """An OP4 of three superelements: refused without --superelement (one line, exit 2),
+    read with it, the DOF map's source said (truth of the numbers:
+    tests/validation/test_nastran_op4_real.py)."""
+    pytest.importorskip("pyyeti")
+    from microg.cli import main
+
+    op4 = Path(__file__).resolve().parents[1] / "data" / "nastran" / "extseout_nas2cam.op4"
+    rc = main(["modes", str(op4), "--units", "mm,N,s"])
+    out, err = capsys.readouterr()
+    assert rc == 2 and err.count("\n") == 1
+    assert "matrices of superelements 101, 102, 0" in err and "--superelement" in err
+    rc = main(["modes", str(op4), "--units", "mm,N,s", "--superelement", "102", "--n-modes", "8"])
+    out, err = capsys.readouterr()
+    assert rc == 0, err
+    assert "DOF map from" in out and "USETTAB, EQEXINS, CSTMS, BGPDTS of superelement 102" in out
+    assert "8 scalar point(s) (SPOINT, first 2995001)" in out
+    rc = main(["locate", str(op4), "--units", "mm,N,s", "--superelement", "0", "--at", "grid:3"])
+    out, err = capsys.readouterr()
+    assert rc == 0, err
+    assert "DOF map from" in out

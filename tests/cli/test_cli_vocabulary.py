@@ -232,3 +232,31 @@ def test_old_option_names_say_the_new_one(capsys, args: list[str], now: str) -> 
     rc, out, err = _run(capsys, *args)
     assert rc == 2 and out == ""
     assert err == f"microg: error: no such option {args[2]}; it is now {now} (see --help)\n"
+
+
+def test_model_file_options_are_one_definition_in_every_model_command(capsys, tmp_path):
+    """--subcase and --superelement: the same option (type, range, help) in modes, analyze,
+    locate, from cli/_common.model_file_options; given where they do not apply, the loader's
+    one-line refusal names the option (exit 2)."""
+    from microg.cli._common import MODEL_FILE_FLAGS
+
+    shown = {}
+    ctx = click.Context(cli)
+    for name in ("modes", "analyze", "locate"):
+        cmd = cli.get_command(ctx, name)
+        assert cmd is not None
+        opts = {p.name: p for p in cmd.params}
+        for key, flag in MODEL_FILE_FLAGS.items():
+            p = opts[key]
+            assert p.opts == [flag]
+            shown.setdefault(key, (p.help, p.type.min))
+            assert (p.help, p.type.min) == shown[key]
+    assert shown["subcase"][1] == 1 and shown["superelement"][1] == 0
+    data = Path(__file__).resolve().parents[1] / "data" / "nastran" / "cla_residual.op2"
+    for cmd in (["analyze", "--out", str(tmp_path / "run")], ["locate"], ["modes"]):
+        rc, out, err = _run(capsys, cmd[0], str(data), *cmd[1:], "--units", "in,lbf,s",
+                            "--subcase", "2")  # fmt: skip
+        assert rc == 2 and err.count("\n") == 1, err
+        assert "--subcase: no modes of subcase 2 in the file (subcases: 1)" in err
+        rc, out, err = _run(capsys, cmd[0], "ioc", *cmd[1:], "--superelement", "0")
+        assert rc == 2 and "--superelement: applies to OP4 files only" in err, err

@@ -7,6 +7,8 @@
   line still win.
 * :func:`num`: every number a command prints, to 4 significant figures.
 * :func:`written`: the one line a command prints after writing its outputs.
+* :func:`model_file_options`: ``--subcase`` (an OP2's) and ``--superelement`` (an OP4's), the
+  same in every command that reads a model.
 """
 
 from __future__ import annotations
@@ -22,7 +24,15 @@ from click.core import ParameterSource
 from microg import defaults
 from microg.defaults import PRESETS, preset
 
-__all__ = ["CONTEXT_SETTINGS", "Option", "given", "num", "preset_option", "written"]
+__all__ = [
+    "CONTEXT_SETTINGS",
+    "Option",
+    "given",
+    "model_file_options",
+    "num",
+    "preset_option",
+    "written",
+]
 
 #: the help of every command: ``-h`` as well as ``--help``, and every default shown
 CONTEXT_SETTINGS: dict[str, Any] = {"help_option_names": ["-h", "--help"], "show_default": True}
@@ -125,4 +135,29 @@ def discretisation_options(command: Callable[..., Any]) -> Callable[..., Any]:
         type=Integer(1, MAX_FUNCTIONS),
         default=defaults.FUNCTIONS,
         help="--method ritz: admissible functions per beam and deformation kind.",
+    )(command)
+
+
+#: the options of :func:`model_file_options`, by parameter name (for ``flag_errors``)
+MODEL_FILE_FLAGS = {"subcase": "--subcase", "superelement": "--superelement"}
+
+
+def model_file_options(command: Callable[..., Any]) -> Callable[..., Any]:
+    """``--subcase`` and ``--superelement``: which part of a NASTRAN results file to read.
+
+    The same in every command that reads a model (``modes``, ``analyze``, ``locate``),
+    passed to :func:`microg.load_model` as ``subcase=`` and ``superelement=``.
+    """
+    command = click.option(
+        "--superelement",
+        type=click.IntRange(min=0),
+        default=None,
+        help="An OP4 holding the matrices of several superelements (nas2cam's SE_START "
+        "blocks, named by the OP2 beside it): the superelement to read.",
+    )(command)
+    return click.option(
+        "--subcase",
+        type=click.IntRange(min=1),
+        default=None,
+        help="An OP2 with modes of several subcases: the subcase to read.",
     )(command)

@@ -16,7 +16,15 @@ import click
 
 from microg import defaults
 from microg.analysis import DEFAULTS
-from microg.cli._common import Option, discretisation_options, given, preset_option, written
+from microg.cli._common import (
+    MODEL_FILE_FLAGS,
+    Option,
+    discretisation_options,
+    given,
+    model_file_options,
+    preset_option,
+    written,
+)
 from microg.cli._errors import flag_errors
 from microg.cli.params import Integer, Number, PathType, PositiveFloat
 from microg.units import LB
@@ -47,6 +55,7 @@ FLAGS = {
     "points": "--points",
     "out": "--out",
     "gravity_gradient": "--gravity-gradient",
+    **MODEL_FILE_FLAGS,
 }
 
 
@@ -181,6 +190,7 @@ PRESET_PARAMS = {k: k for k in ("method", "plane", "damping", "functions")}
     help="Add a vibration absorber of this mass ratio to the report-rule mount.",
 )
 @click.option("--units", default=None, help="Units of a NASTRAN/UFF model: 'LENGTH,FORCE,TIME'.")
+@model_file_options
 @click.option(
     "--wtmass",
     type=PositiveFloat(),
@@ -239,6 +249,8 @@ def analyze(
     units: str | None,
     wtmass: float | None,
     points_file: Path | None,
+    subcase: int | None,
+    superelement: int | None,
     sources: str | None,
     out_dir: Path,
     as_json: bool,
@@ -286,7 +298,13 @@ def analyze(
     command = "microg " + " ".join(shlex.quote(a) for a in sys.argv[1:])
     reader = {
         k: v
-        for k, v in (("units", units), ("wtmass", wtmass), ("points", points_file))
+        for k, v in (
+            ("units", units),
+            ("wtmass", wtmass),
+            ("points", points_file),
+            ("subcase", subcase),
+            ("superelement", superelement),
+        )
         if v is not None
     }
     flags = {**FLAGS, "n": "--functions" if method == "ritz" else "--elements"}

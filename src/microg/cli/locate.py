@@ -22,7 +22,16 @@ import numpy as np
 
 from microg import defaults
 from microg._io import dumps
-from microg.cli._common import Option, discretisation_options, given, num, preset_option, written
+from microg.cli._common import (
+    MODEL_FILE_FLAGS,
+    Option,
+    discretisation_options,
+    given,
+    model_file_options,
+    num,
+    preset_option,
+    written,
+)
 from microg.cli.params import Integer, Number, PathType, PositiveFloat
 from microg.errors import InputError
 from microg.location.amap import DEFAULTS as LOCATE_DEFAULTS
@@ -53,6 +62,7 @@ FLAGS: dict[str, str] = {
     "units": "--units",
     "wtmass": "--wtmass",
     "points": "--points",
+    **MODEL_FILE_FLAGS,
 }
 
 
@@ -262,6 +272,7 @@ def _unit_system(station: Any, model: str) -> str | None:
 @click.option(
     "--units", default=None, help="Units of a NASTRAN/UFF model file: 'LENGTH,FORCE,TIME'."
 )
+@model_file_options
 @click.option(
     "--wtmass",
     type=PositiveFloat(),
@@ -300,6 +311,8 @@ def locate(
     units: str | None,
     wtmass: float | None,
     points_file: Path | None,
+    subcase: int | None,
+    superelement: int | None,
     as_json: bool,
     out_dir: Path | None,
 ) -> None:
@@ -343,6 +356,8 @@ def locate(
             units=units,
             wtmass=wtmass,
             points=points_file,
+            subcase=subcase,
+            superelement=superelement,
         )
     text = dumps(result.to_dict())
     if out_dir is not None:

@@ -13,7 +13,16 @@ from typing import Any
 import click
 
 from microg import defaults
-from microg.cli._common import Option, discretisation_options, given, num, preset_option, written
+from microg.cli._common import (
+    MODEL_FILE_FLAGS,
+    Option,
+    discretisation_options,
+    given,
+    model_file_options,
+    num,
+    preset_option,
+    written,
+)
 from microg.cli.params import Integer, PathType, PositiveFloat
 
 __all__ = ["modes"]
@@ -26,9 +35,9 @@ FLAGS = {
     "units": "--units",
     "wtmass": "--wtmass",
     "points": "--points",
-    "subcase": "--subcase",
     "coupled_mass": "--coupled-mass",
     "constrained": "--constrained",
+    **MODEL_FILE_FLAGS,
 }
 
 
@@ -94,12 +103,7 @@ def _effective_percent(m: Any) -> dict[str, Any]:
     default=None,
     help="Also write the modes as UFF datasets 15+55 (+164 units) to this file.",
 )
-@click.option(
-    "--subcase",
-    type=click.IntRange(min=1),
-    default=None,
-    help="An OP2 with modes of several subcases: the subcase to read.",
-)
+@model_file_options
 @click.option(
     "--coupled-mass",
     "coupled_mass",
@@ -131,6 +135,7 @@ def modes(
     uff_out: Path | None,
     subcase: int | None,
     coupled_mass: str | None,
+    superelement: int | None,
     constrained: bool,
     as_json: bool,
 ) -> None:
@@ -162,6 +167,7 @@ def modes(
         ("points", points),
         ("subcase", subcase),
         ("coupled_mass", coupled_mass),
+        ("superelement", superelement),
     )
     options = {k: v for k, v in reader if v is not None}
     with flag_errors(FLAGS):

@@ -209,21 +209,23 @@ def location_structure(
     return structure, d
 
 
-def _load(model: Any, units: str | None, wtmass: float | None, points: str | Path | None) -> Any:
-    """A model object as it is, or a path / shipped name read by the one model loader."""
+def _load(model: Any, **reader: Any) -> Any:
+    """A model object as it is, or a path / shipped name read by the one model loader.
+
+    ``reader``: the loader's options (units, wtmass, points, subcase, superelement).
+    """
+    given = {k: v for k, v in reader.items() if v is not None}
     if not isinstance(model, str | Path):
-        if units is not None or wtmass is not None or points is not None:
+        if given:
             raise InputError(
-                "units, wtmass and points apply when the model is read from a file",
-                where="units"
-                if units is not None
-                else ("wtmass" if wtmass is not None else "points"),
+                f"{', '.join(reader)} apply when the model is read from a file",
+                where=next(iter(given)),
                 fix="pass the file's path, or give them to microg.load_model",
             )
         return model
     from microg.models.load import load_model
 
-    return load_model(model, units=units, wtmass=wtmass, points=points)
+    return load_model(model, **given)
 
 
 def is_imported(model: Any) -> bool:
@@ -281,6 +283,8 @@ def locate(
     units: str | None = None,
     wtmass: float | None = None,
     points: str | Path | None = None,
+    subcase: int | None = None,
+    superelement: int | None = None,
 ) -> LocateResult:
     """Where to put the laboratory: the acceleration map of a crew force and its best point.
 
@@ -335,11 +339,22 @@ def locate(
         NASTRAN PARAM,WTMASS of the run.
     points : str or Path, optional
         Points/options TOML file naming grids of an imported model.
+    subcase : int, optional
+        The subcase of an OP2 with modes of several.
+    superelement : int, optional
+        The superelement of an OP4 holding the matrices of several.
     """
     from microg.dynamics.forces import crew_force
     from microg.dynamics.modes import solve_modes
 
-    mdl = _load(model, units, wtmass, points)
+    mdl = _load(
+        model,
+        units=units,
+        wtmass=wtmass,
+        points=points,
+        subcase=subcase,
+        superelement=superelement,
+    )
     if method not in ("ritz", "fem"):
         raise InputError(f"unknown method {method!r}", where="method", fix="use ritz or fem")
     if measure not in MEASURES:

@@ -168,6 +168,12 @@ def _read_lines(
                     fix="write INCLUDE 'file.bdf'",
                 )
             name = m.group(1).strip()
+            if any(ord(ch) < 32 for ch in name):  # a NUL is no path (os raises ValueError)
+                raise InputError(
+                    "INCLUDE file name holds a control character",
+                    where=f"{shown}:{number}",
+                    fix="write INCLUDE 'file.bdf'",
+                )
             target = Path(name) if Path(name).is_absolute() else path.parent / name
             target_shown = str(Path(shown).parent / name) if not Path(name).is_absolute() else name
             if depth >= MAX_INCLUDE_DEPTH or target.resolve() in stack:
@@ -236,7 +242,9 @@ def _is_continuation(line: str) -> bool:
     return not line[:8].strip()
 
 
-def read_cards(path: str | Path, notes: list[str] | None = None) -> tuple[list[Card], list[str]]:
+def read_cards(
+    path: str | Path, notes: list[str] | None = None, *, superelements: bool = False
+) -> tuple[list[Card], list[str]]:
     """Bulk data cards of a deck and its case control lines.
 
     Parameters
@@ -246,6 +254,10 @@ def read_cards(path: str | Path, notes: list[str] | None = None) -> tuple[list[C
     notes : list of str, optional
         Receives a note per executive/case-control INCLUDE that does not exist (skipped);
         without it such an INCLUDE is an error, as a bulk-data one always is.
+    superelements : bool
+        Read the cards of ``BEGIN SUPER`` sections too, joined with the main bulk data's
+        (the punch file of an external superelement, for its DOF list); otherwise such a
+        section is an error.
 
     Returns
     -------
@@ -271,7 +283,7 @@ def read_cards(path: str | Path, notes: list[str] | None = None) -> tuple[list[C
     )
     case: list[str] = []
     if begin is not None:
-        if re.match(r"\s*BEGIN\s+SUPER", lines[begin].text, re.I):
+        if not superelements and re.match(r"\s*BEGIN\s+SUPER", lines[begin].text, re.I):
             raise InputError(
                 "superelement bulk data (BEGIN SUPER) is not supported",
                 where=f"{lines[begin].file}:{lines[begin].number}",
@@ -292,6 +304,11 @@ def read_cards(path: str | Path, notes: list[str] | None = None) -> tuple[list[C
             continue
         if re.match(r"\s*ENDDATA\b", text, re.I):
             break
+        if superelements and re.match(r"\s*BEGIN\s+(BULK|SUPER)", text, re.I):
+            if cur is not None:
+                cards.append(_card(cur, cur_at))
+                cur = None
+            continue
         where = f"{ln.file}:{ln.number}"
         if cur is not None and _is_continuation(text):
             if "," in text:

@@ -3,8 +3,9 @@
 Dispatch by suffix:
 
 * ``.op2``: NASTRAN SOL 103 results (:func:`microg.models.nastran.modal_model_from_op2`);
-* ``.op4``: NASTRAN matrices MAA/KAA with a DOF map beside (``<stem>.dofmap.csv``: one row
-  ``grid, component, x, y, z`` per a-set DOF, positions in the file's length unit);
+* ``.op4``: NASTRAN a-set matrices (MAA/KAA, or EXTSEOUT's MXX/KXX), their DOFs from the run's
+  files beside (:func:`microg.models.dofmap.dof_map_for_op4`: ``<stem>.op2`` USET/EQEXIN,
+  ``<stem>.pch`` EXTRN, else ``<stem>.dofmap.csv``: ``grid, component, x, y, z`` per row);
 * ``.unv`` / ``.uff``: UFF 15/2411 + 55 (+164) (:func:`microg.models.uff.modal_model_from_uff`);
 * ``.npz``: microg's own modal-model file (:func:`microg.models.modal.load_modal_model`);
 * ``.toml`` or a shipped name: a station (:func:`microg.models.toml.load_station`);
@@ -19,8 +20,6 @@ from __future__ import annotations
 
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
-
-import numpy as np
 
 from microg import _args
 from microg.errors import InputError
@@ -83,6 +82,7 @@ def load_model(
     points: str | Path | None = None,
     subcase: int | None = None,
     coupled_mass: str | None = None,
+    superelement: int | None = None,
 ) -> Any:
     """Read a model of any kind microg knows (see the module docstring).
 
@@ -102,6 +102,9 @@ def load_model(
         The mass of a NASTRAN deck with ``PARAM,COUPMASS`` > 0 (a deck option only;
         :func:`microg.models.bdf.load_bdf`): default NASTRAN's coupled CBAR mass as current
         Simcenter Nastran forms it (:data:`microg.defaults.NASTRAN_COUPLED_MASS`).
+    superelement : int, optional
+        The superelement of an OP4 holding the matrices of several (nas2cam's SE_START
+        blocks) or beside an OP2 holding the DOFs of several (an OP4 option only).
 
     Returns
     -------
@@ -120,6 +123,14 @@ def load_model(
         isinstance(subcase, bool) or not isinstance(subcase, int) or subcase < 1
     ):
         raise InputError(f"expected a positive integer, got {subcase!r}", where="subcase")
+    if superelement is not None and suffix != ".op4":
+        raise InputError("applies to OP4 files only", where="superelement", fix="leave it out")
+    if superelement is not None and (
+        isinstance(superelement, bool) or not isinstance(superelement, int) or superelement < 0
+    ):
+        raise InputError(
+            f"expected a superelement id (0 or more), got {superelement!r}", where="superelement"
+        )
     if loads_station(path, points):
         # a station (a file or a shipped name): the modal readers are not needed
         from microg.models.toml import load_station
@@ -164,21 +175,4 @@ def load_model(
     from microg.models.nastran import modal_model_from_op4
 
     u = _units(units, wtmass, opts, label, need=True)
-    side = p.with_suffix(".dofmap.csv")
-    if not side.is_file():
-        raise InputError(
-            f"an OP4 needs its DOF map beside it ({side.name}: grid, component, x, y, z per "
-            "a-set DOF)",
-            where=label,
-        )
-    try:
-        rows = np.loadtxt(side, delimiter=",", ndmin=2, comments="#")
-    except ValueError as exc:
-        raise InputError(f"cannot read the DOF map: {exc}", where=str(side)) from None
-    if rows.shape[1] != 5:
-        raise InputError("DOF map rows must be grid, component, x, y, z", where=str(side))
-    dof_map = rows[:, :2].astype(int)
-    ids, first = np.unique(dof_map[:, 0], return_index=True)
-    return modal_model_from_op4(
-        p, u, dof_map=dof_map, xyz=rows[first, 2:5], grid_ids=ids, points=opts.points
-    )
+    return modal_model_from_op4(p, u, points=opts.points, superelement=superelement)

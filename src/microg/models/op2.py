@@ -41,7 +41,7 @@ from microg.models.coords import (
     nastran_coordinates,
 )
 
-__all__ = ["Op2File", "Op2Modes", "read_op2_modes"]
+__all__ = ["Op2DofTables", "Op2File", "Op2Modes", "read_op2_dof_tables", "read_op2_modes"]
 
 
 # --------------------------------------------------------------------------- records
@@ -725,3 +725,199 @@ def read_op2_modes(path: str | Path, *, subcase: int | None = None) -> Op2Modes:
         tables=tuple(f"{t.name} (SE {t.se})" for t in chosen.values()),
         grid_se=grid_se,
     )
+
+
+# --------------------------------------------------------------------------- DOF tables
+
+#: USET bits (NASTRAN's NDDL, as pyyeti's ``n2p.mkusetmask`` lists them): the a-set is any
+#: DOF with the A bit or one of its subsets' bits (Q, R, B, C); bit 1 is the B set's second
+#: bit, which some writers also set on the S set, so it is cleared where an S bit (SG, SB) is
+USET_A_MASK = (1 << 22) | 8 | (2 | (1 << 21)) | (1 << 20) | (1 << 7)
+USET_S_MASK = (1 << 9) | (1 << 10)
+
+
+@dataclass(frozen=True)
+class Op2DofTables:
+    """One superelement's DOF tables from an OP2 (USET, EQEXIN(S), BGPDT(S), CSTM(S)).
+
+    Attributes
+    ----------
+    superelement : int
+        From SLIST (its order of the superelements), 0 without one.
+    uset : ndarray (n,) uint64 or None
+        The USET word of each g-set DOF, internal order (bit 1 cleared on the S set).
+    ids : ndarray (p,) int
+        External ids of the points (grids and scalar points), internal order.
+    kinds : ndarray (p,) int
+        EQEXIN's point type: 1 grid (6 DOFs), 2 scalar point, 3 extra point (1 DOF).
+    xyz : ndarray (p, 3)
+        Basic positions (BGPDT; zero for scalar points), file length unit.
+    cd : ndarray (p,) int
+        Output (displacement) system of each point (-1 for scalar points).
+    coords : dict of int to CoordinateFrame
+        CSTM's systems (origin and axes resolved to basic by NASTRAN).
+    tables : tuple of str
+        The data blocks read, by their whole names.
+    """
+
+    superelement: int
+    uset: np.ndarray | None
+    ids: np.ndarray
+    kinds: np.ndarray
+    xyz: np.ndarray
+    cd: np.ndarray
+    coords: dict[int, CoordinateFrame]
+    tables: tuple[str, ...]
+
+    @property
+    def dof_ids(self) -> np.ndarray:
+        """The point id of each g-set DOF, internal order."""
+        return np.repeat(self.ids, np.where(self.kinds == 1, 6, 1))
+
+    @property
+    def dof_components(self) -> np.ndarray:
+        """The component of each g-set DOF: 1..6 on a grid, 0 on a scalar or extra point."""
+        parts = [np.arange(1, 7) if k == 1 else np.zeros(1, int) for k in self.kinds]
+        return np.concatenate(parts) if parts else np.zeros(0, int)
+
+    def a_set(self) -> np.ndarray:
+        """Boolean over the g-set DOFs: those in the a-set (from USET's bits)."""
+        if self.uset is None:
+            raise InputError(
+                f"superelement {self.superelement} has no USET table", where=", ".join(self.tables)
+            )
+        u = self.uset.copy()
+        s = (u & USET_S_MASK) != 0
+        u[s] &= ~np.uint64(2)
+        return (u & USET_A_MASK) != 0
+
+
+def _eqexin(f: Op2File, recs: list[bytes], name: str) -> tuple[np.ndarray, np.ndarray]:
+    """(external ids, internal ids, SIL*10 + type) from EQEXIN(S), sorted to internal order."""
+    if len(recs) < 3:
+        raise f._fail(f"{name} has {len(recs) - 1} records, not 2")
+    r1, r2 = f.ints(recs[1]), f.ints(recs[2])
+    if r1.size % 2 or r1.size != r2.size or not np.array_equal(r1[::2], r2[::2]):
+        raise f._fail(f"{name}'s two records do not list the same points")
+    order = np.argsort(r1[1::2], kind="stable")
+    if not np.array_equal(np.sort(r1[1::2]), np.arange(1, r1.size // 2 + 1)):
+        raise f._fail(f"{name}'s internal ids are not 1..{r1.size // 2}")
+    return r1[::2][order].astype(np.int64), r2[1::2][order].astype(np.int64)
+
+
+def _bgpdt_points(f: Op2File, recs: list[bytes], n: int, name: str) -> tuple[Any, Any]:
+    """(cd, basic xyz) of ``n`` points in internal order from BGPDT(S), either layout."""
+    if len(recs) < 2:
+        raise f._fail(f"{name} has no data record")
+    rec = recs[1]
+    words = len(rec) // f.word
+    if n and words == 4 * n:  # the older layout: cd, x, y, z (reals)
+        bi, bf = f.ints(rec).reshape(n, 4), f.floats(rec).reshape(n, 4)
+        return bi[:, 0].astype(int), bf[:, 1:4].astype(float)
+    per = 6 + (6 if f.word == 4 else 3)  # cd, internal, external, type, set, boundary; xyz f8
+    if n == 0 or words != per * n:
+        raise f._fail(f"{name} holds {words} words, not {per} (or 4) for each of {n} points")
+    dt = np.dtype([("i", f.endian + ("i4" if f.word == 4 else "i8"), 6), ("x", f.endian + "f8", 3)])
+    data = np.frombuffer(rec, dt)
+    return data["i"][:, 0].astype(int), data["x"].astype(float)
+
+
+def _cstm(f: Op2File, recs: list[bytes], name: str) -> dict[int, CoordinateFrame]:
+    """CSTM(S): id, type, origin and axes of each system (NASTRAN resolves them to basic)."""
+    if len(recs) < 3:
+        raise f._fail(f"{name} has {len(recs) - 1} records, not 2")
+    r1 = f.ints(recs[1])
+    vals = np.frombuffer(recs[2], f.endian + "f8")
+    if r1.size % 4:
+        raise f._fail(f"{name}'s first record is not 4 words per system")
+    kinds = {1: "rectangular", 2: "cylindrical", 3: "spherical"}
+    out = {}
+    for cid, kind, _, at in r1.reshape(-1, 4):
+        if int(kind) not in kinds or at < 1 or at - 1 + 12 > vals.size:
+            raise f._fail(f"{name}: system {int(cid)} has type {int(kind)} or offset {int(at)}")
+        v = vals[at - 1 : at + 11].astype(float)
+        t = v[3:].reshape(3, 3)  # basic = T local + origin: T's columns are the axes
+        out[int(cid)] = CoordinateFrame(f"cs:{int(cid)}", kinds[int(kind)], v[:3], t.T.copy())
+    return out
+
+
+def read_op2_dof_tables(path: str | Path) -> list[Op2DofTables]:
+    """Every superelement's USET/EQEXIN(S)/BGPDT(S)/CSTM(S) of an OP2 (nas2cam's DMAP writes them).
+
+    Layouts as pyyeti's ``nastran.op2.OP2.rdn2cop2`` and pyNastran read them: SLIST (7 words
+    per superelement, the first its id) orders the superelements; each USET* table starts
+    one superelement's group, EQEXIN(S) (record 1: external and internal ids, record 2:
+    external id and 10 SIL + type, both in external order), CSTM(S) (record 1: id, type,
+    -, offset into record 2's reals: origin and the 3x3 transformation to basic) and BGPDT(S)
+    (each point's output system, 6 integers, basic x, y, z in 8-byte reals; or 4 words) follow.
+
+    Parameters
+    ----------
+    path : str or Path
+
+    Returns
+    -------
+    list of Op2DofTables
+        One per superelement, in file order (empty when the file has no EQEXIN).
+    """
+    f = Op2File(path)
+    selist: list[int] = []
+    for _, _, recs in f.named("SLIST"):
+        if len(recs) >= 2:
+            r = f.ints(recs[1])
+            if r.size % 7:
+                raise f._fail("SLIST is not 7 words per superelement")
+            selist = [int(v) for v in r[::7]]
+    groups: list[dict[str, tuple[str, list[bytes]]]] = []
+    for name, _, recs in f.tables:
+        kind = next((k for k in ("USET", "EQEXIN", "BGPDT", "CSTM") if name.startswith(k)), None)
+        if kind is None or name.startswith(("BGPDTOLD", "CSTMA")):
+            continue
+        if kind == "USET" or not groups or kind in groups[-1]:
+            groups.append({})
+        groups[-1][kind] = (name, recs)
+    out = []
+    for k, g in enumerate(groups):
+        if "EQEXIN" not in g:
+            continue
+        se = selist[k] if k < len(selist) and len(selist) == len(groups) else (0 if k == 0 else k)
+        ids, code = _eqexin(f, g["EQEXIN"][1], g["EQEXIN"][0])
+        kinds = code % 10
+        if np.any((kinds < 1) | (kinds > 3)):
+            raise f._fail(f"{g['EQEXIN'][0]}: point types other than 1, 2, 3")
+        n_dof = int(np.where(kinds == 1, 6, 1).sum())
+        sil = code // 10
+        first = np.concatenate([[1], 1 + np.cumsum(np.where(kinds == 1, 6, 1))[:-1]])
+        if ids.size and not np.array_equal(sil, first):
+            raise f._fail(f"{g['EQEXIN'][0]}: scalar index list out of internal order")
+        xyz = np.zeros((ids.size, 3))
+        cd = np.where(kinds == 1, 0, -1)
+        if "BGPDT" in g:
+            cd_b, xyz = _bgpdt_points(f, g["BGPDT"][1], ids.size, g["BGPDT"][0])
+            cd = np.where(kinds == 1, cd_b, -1)
+        coords = _cstm(f, g["CSTM"][1], g["CSTM"][0]) if "CSTM" in g else {}
+        uset = None
+        if "USET" in g:
+            urecs = g["USET"][1]
+            if len(urecs) < 2:
+                raise f._fail(f"{g['USET'][0]} has no data record")
+            uset = f.ints(urecs[1]).astype(np.int64).astype(np.uint64) & np.uint64(0xFFFFFFFF)
+            if uset.size != n_dof:
+                raise InputError(
+                    f"{g['USET'][0]} of superelement {se} has {uset.size} DOFs, "
+                    f"{g['EQEXIN'][0]} {n_dof}",
+                    where=f.path,
+                )
+        out.append(
+            Op2DofTables(
+                superelement=se,
+                uset=uset,
+                ids=ids,
+                kinds=kinds.astype(int),
+                xyz=np.asarray(xyz, float),
+                cd=np.asarray(cd, int),
+                coords=coords,
+                tables=tuple(v[0] for v in g.values()),
+            )
+        )
+    return out

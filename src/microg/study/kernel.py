@@ -88,6 +88,8 @@ __all__ = [
 
 #: the transient criteria set the analysis' assessment judges (assess's default)
 TRANSIENT_SET = "iss"
+
+
 @dataclass(frozen=True)
 class Basis:
     """The modal basis of one model variant, at the study's points (what every block needs).

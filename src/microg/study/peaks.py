@@ -40,7 +40,6 @@ PEAK_RTOL = 1e-10
 _PEAK_ROUNDS = 30
 
 
-
 class Rows(Protocol):
     """What the peaks need of a modal group (:class:`microg.study.kernel.ModalGroup`)."""
 

@@ -49,8 +49,12 @@ VARIABLES: dict[str, tuple[tuple[str, ...], str, str, str]] = {
     "band_rms_g": (("axis", "band"), "float64", "g", "1/3-octave band RMS per axis"),
     "margin": ((), "float64", "1", "worst limit / band RMS over the judged bands and axes"),
     "complies": ((), "bool", "", "the band verdict (and verified transient criteria)"),
-    "peak_certified": ((), "bool", "", "the peaks are the certified exact maxima (else the "
-                       "sampled record's)"),
+    "peak_certified": (
+        (),
+        "bool",
+        "",
+        "the peaks are the certified exact maxima (else the sampled record's)",
+    ),
     "computed": ((), "bool", "", "the case is in the plan and has been computed"),
 }
 
