@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import microg
-from microg.plotting import interactive
+from microg.plotting.interactive import model as interactive
 
 
 @pytest.fixture(scope="module")

@@ -43,7 +43,7 @@ def test_assess_writes_a_report_with_every_band(tmp_path: Path) -> None:
     assert main(["assess", str(ROOT / "examples" / "measured.csv"), "--out", str(out)]) == 0
     html = (out / "report.html").read_text()
     d = json.loads((out / "results.json").read_text())
-    (key, obs), = d["observations"].items()
+    ((key, obs),) = d["observations"].items()
     to = obs["third_octave"]
     rows = re.findall(r'<tr class="(unjudged|fail|)">\s*<td>', html)
     assert len(rows) == len(to["center_hz"])
@@ -54,9 +54,27 @@ def test_assess_writes_a_report_with_every_band(tmp_path: Path) -> None:
         row = html.split(f'<td class="l">{c["name"]}</td>', 1)[1].split("</tr>", 1)[0]
         assert criterion_verdict(c)[0] in row and c["why"] in row
     assert ("Verdict: complies" in html) == obs["complies"]
-    assert len(re.findall(r'<img [^>]*src="data:image/png;base64,', html)) == len(
-        list(out.glob("*.png"))
-    )
+    # every PNG written is on the page: as an image, or as the interactive chart standing for it
+    n_img = len(re.findall(r'<img [^>]*src="data:image/png;base64,', html))
+    archived = set(re.findall(r"Archived as <code>([^<]+)</code>", html))
+    pngs = {p.name for p in out.glob("*.png")}
+    assert n_img + len(archived) == len(pngs) and archived <= pngs
+
+
+def test_static_pages_have_pngs_only(tmp_path: Path) -> None:
+    # --static: every figure a PNG, no chart, no plotly.js (about 4.8 MB less)
+    runs = {
+        "assess": ["assess", str(ROOT / "examples" / "measured.csv")],
+        "quasi-steady": ["quasi-steady", "ioc"],
+        "locate": ["locate", "ioc"],
+    }
+    for name, args in runs.items():
+        out = tmp_path / name
+        assert main([*args, "--out", str(out), "--static"]) == 0
+        html = (out / "report.html").read_text()
+        assert "plotly" not in html.lower(), name
+        n_img = len(re.findall(r'<img [^>]*src="data:image/png;base64,', html))
+        assert n_img == len(list(out.glob("*.png"))) >= 1, name
 
 
 def test_quasi_steady_writes_a_report_with_every_point(tmp_path: Path) -> None:

@@ -143,6 +143,55 @@ class Observation:
 
         return observation_figure(self, ax=ax, kind=kind)
 
+    def plot_interactive(self, kind: str = "bands") -> Any:
+        """An interactive chart at this point (a plotly Figure), the live axes only.
+
+        Parameters
+        ----------
+        kind : {"history", "bands", "psd", "integrated"}
+            The acceleration history (micro-g), the 1/3-octave bands against the limit
+            (micro-g, judged bands filled), the PSD (g^2/Hz) or the 10-s integrated
+            acceleration (micro-g s); see :mod:`microg.plotting.interactive`.
+        """
+        from microg.plotting.analysis import live_axes
+        from microg.plotting.interactive import bands, histories, spectra
+
+        a, r = self.assessment, self.response
+        rows = live_axes(r.acceleration)
+        axes = tuple("xyz"[i] for i in rows)
+        if kind == "history":
+            return histories.history_chart(
+                r.timepts,
+                r.acceleration[rows],
+                axes=axes,
+                title=f"Acceleration at {self.name} (peak {a.peak_accel_g:.3g} g)",
+            )
+        if kind == "bands":
+            return bands.bands_chart(
+                a.third_octave,
+                axes=a.axes,
+                rows=rows,
+                title=f"1/3-octave band RMS at {self.name} vs {a.requirement}",
+                verdict_range_hz=a.verdict_range_hz,
+            )
+        if kind == "psd":
+            return spectra.psd_chart(
+                a.spectrum, axes=a.axes, rows=rows, title=f"PSD at {self.name}"
+            )
+        if kind == "integrated":
+            integ = a.integrated_sliding
+            return histories.integrated_chart(
+                integ,
+                axes=a.axes,
+                rows=rows,
+                title=f"{integ.window_s:g}-s integrated acceleration at {self.name}",
+            )
+        from microg.errors import InputError
+
+        raise InputError(
+            f"unknown chart {kind!r}", where="kind", fix="use history, bands, psd or integrated"
+        )
+
 
 @dataclass(frozen=True)
 class Analysis:

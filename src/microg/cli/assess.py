@@ -95,7 +95,12 @@ FLAGS = {
     "out_dir",
     type=PathType(file_okay=False, path_type=Path),
     default=None,
-    help="Also write results.json and the figures into this directory.",
+    help="Also write results.json, the figures and report.html into this directory.",
+)
+@click.option(
+    "--static",
+    is_flag=True,
+    help="Write report.html with PNG figures only (no interactive chart, ~4.8 MB smaller).",
 )
 def assess(
     file: Path,
@@ -109,6 +114,7 @@ def assess(
     point: str | None,
     as_json: bool,
     out_dir: Path | None,
+    static: bool,
 ) -> None:
     """Assess a measured acceleration record FILE against a requirement.
 
@@ -186,11 +192,16 @@ def assess(
 
             files: dict[str, bytes | str] = {"results.json": dumps(payload)}
             per_sensor: dict[str, dict[str, bytes]] = {}
+            charts: dict[str, dict[str, list[Any]]] = {}
             for r in results:
                 figs = _figures(r)
                 per_sensor[r["key"]] = {k: v for k, v in figs.items() if isinstance(v, bytes)}
                 files.update(figs)
-            files["report.html"] = render_assessment(payload, per_sensor)
+                if not static:
+                    charts[r["key"]] = _charts(r)
+            files["report.html"] = render_assessment(
+                payload, per_sensor, None if static else charts
+            )
             path = write_output_files(out_dir, files, where="out")
     if as_json:
         click.echo(dumps(payload))
@@ -319,14 +330,30 @@ def run_assessment(
     return {"record": record, "key": key, "assessment": a, "intervals": iv, "json": doc}
 
 
+def _integrated(a: Any) -> Any:
+    """The integral the transient criteria judge: PIMS's blocks when there is one, else sliding."""
+    pims = a.transient_basis == "pims" and a.integrated_pims is not None
+    return a.integrated_pims if pims else a.integrated_sliding
+
+
 def _figures(result: dict[str, Any]) -> dict[str, bytes | str]:
+    """The PNG figures of one sensor, by file name, in report order."""
     from microg._io import safe_filenames
     from microg.plotting.common import png_bytes
-    from microg.plotting.environment import plot_psd, plot_third_octave
+    from microg.plotting.environment import (
+        plot_integrated,
+        plot_psd,
+        plot_third_octave,
+        plot_time_history,
+    )
 
-    a, iv, key = result["assessment"], result["intervals"], result["key"]
+    a, iv, key, rec = result["assessment"], result["intervals"], result["key"], result["record"]
     s = safe_filenames([key])[key]
     figs = {
+        "history": plot_time_history(
+            rec.timepts, rec.accel, axes=a.axes, title=f"Acceleration at {key}"
+        ),
+        "integrated": plot_integrated(_integrated(a), axes=a.axes),
         "third-octave": plot_third_octave(
             a, title=f"1/3-octave band RMS at {key} vs {a.requirement}"
         ),
@@ -340,6 +367,31 @@ def _figures(result: dict[str, Any]) -> dict[str, bytes | str]:
     if "overlay" in result:
         figs["prediction-overlay"] = result["overlay"].plot()
     return {f"{s}-{k}.png": png_bytes(f) for k, f in figs.items()}
+
+
+def _charts(result: dict[str, Any]) -> dict[str, list[Any]]:
+    """The interactive charts of one sensor (plotly Figures), by the PNG each stands for."""
+    from microg._io import safe_filenames
+    from microg.plotting.interactive.histories import history_chart, integrated_chart
+
+    a, iv, key, rec = result["assessment"], result["intervals"], result["key"], result["record"]
+    s = safe_filenames([key])[key]
+    charts = {
+        "history": history_chart(
+            rec.timepts, rec.accel, axes=a.axes, title=f"Acceleration at {key}"
+        ),
+        "integrated": integrated_chart(_integrated(a), axes=a.axes),
+        "third-octave": a.plot_interactive("third_octave"),
+        "psd": a.plot_interactive("psd"),
+        "percentiles": iv.bands.plot_interactive(row="rss"),
+        "spectrogram": iv.spectrogram.plot_interactive(),
+        "cumulative-rms": iv.cumulative.plot_interactive(),
+        "band-rms-time": iv.band_limited.plot_interactive(),
+        "interval-stats": iv.stats.plot_interactive(),
+    }
+    if "overlay" in result:
+        charts["prediction-overlay"] = result["overlay"].plot_interactive()
+    return {f"{s}-{k}.png": [c] for k, c in charts.items()}
 
 
 def _summary(result: dict[str, Any]) -> None:

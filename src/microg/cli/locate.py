@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import sys
 import tempfile
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -292,7 +293,12 @@ def _unit_system(station: Any, model: str) -> str | None:
     "out_dir",
     type=PathType(file_okay=False, path_type=Path),
     default=None,
-    help="Write OUT/map.json and OUT/map.png.",
+    help="Write OUT/map.json, OUT/map.png and OUT/report.html (the map in 3-D).",
+)
+@click.option(
+    "--static",
+    is_flag=True,
+    help="Write report.html with the PNG map only (no interactive 3-D map, ~4.8 MB smaller).",
 )
 def locate(
     model: str,
@@ -315,6 +321,7 @@ def locate(
     superelement: int | None,
     as_json: bool,
     out_dir: Path | None,
+    static: bool,
 ) -> None:
     """Where to put the laboratory: peak acceleration along MODEL from a crew push-off.
 
@@ -363,9 +370,13 @@ def locate(
     if out_dir is not None:
         from microg._io import write_output_files
         from microg.plotting.common import png_bytes
+        from microg.report.location import render_locate
 
         png = png_bytes(result.plot())
-        path = write_output_files(out_dir, {"map.json": text, "map.png": png}, where="--out")
+        command = " ".join(["microg", *sys.argv[1:]]) if sys.argv else "microg locate"
+        html = render_locate(result, png, static=static, command=command)
+        files = {"map.json": text, "map.png": png, "report.html": html}
+        path = write_output_files(out_dir, files, where="--out")
     if as_json:
         click.echo(text)
         return

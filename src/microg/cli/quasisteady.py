@@ -227,9 +227,15 @@ def _vector(text: str | None, where: str, *, accel: bool = False) -> list[float]
     "out_dir",
     type=PathType(file_okay=False, path_type=Path),
     default=None,
-    help="Directory for quasi-steady.json, the map (CSV) and its figure (replaced as a whole).",
+    help="Directory for quasi-steady.json, the map (CSV), its figure and report.html (replaced "
+    "as a whole).",
 )
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
+@click.option(
+    "--static",
+    is_flag=True,
+    help="Write report.html with the PNG figure only (no interactive 3-D map, ~4.8 MB smaller).",
+)
 def quasi_steady(
     model: str,
     attitude: str,
@@ -253,6 +259,7 @@ def quasi_steady(
     elements: int,
     out_dir: Path | None,
     as_json: bool,
+    static: bool,
 ) -> None:
     """Quasi-steady acceleration (below 0.01 Hz) of MODEL at its named points and the CM.
 
@@ -328,7 +335,7 @@ def quasi_steady(
         )
     data = result.to_dict()
     if out_dir is not None:
-        _write(result, data, out_dir)
+        _write(result, data, out_dir, static=static)
     if as_json:
         from microg._io import dumps
 
@@ -337,7 +344,7 @@ def quasi_steady(
         _summary(result, out_dir)
 
 
-def _write(result: Any, data: dict[str, Any], out_dir: Path) -> None:
+def _write(result: Any, data: dict[str, Any], out_dir: Path, *, static: bool = False) -> None:
     import io
 
     from microg._io import dumps, write_run_directory
@@ -350,7 +357,8 @@ def _write(result: Any, data: dict[str, Any], out_dir: Path) -> None:
         buf = io.BytesIO()
         result.plot().savefig(buf, format="png", dpi=110)
         png = files["quasi-steady-map.png"] = buf.getvalue()
-    files["report.html"] = render_quasi_steady(data, png)
+    chart = None if static or result.map is None else result.plot3d()
+    files["report.html"] = render_quasi_steady(data, png, chart)
     write_run_directory(out_dir, files, where="--out")
 
 

@@ -256,6 +256,35 @@ class Assessment:
             return plot_psd(self.spectrum, axes=self.axes, ax=ax)
         raise InputError(f"unknown plot {kind!r}", where="kind", fix="use third_octave or psd")
 
+    def plot_interactive(self, kind: str = "third_octave") -> Any:
+        """An interactive chart of the assessment (a plotly Figure).
+
+        Parameters
+        ----------
+        kind : {"third_octave", "psd", "integrated"}
+            The bands against the limit (micro-g, judged bands filled), the PSD (g^2/Hz), or
+            the integrated acceleration the transient criteria judge (micro-g s: PIMS's blocks
+            when ``transient_basis`` is ``pims`` and the record holds one, else sliding).
+        """
+        from microg.plotting.interactive import bands, histories, spectra
+
+        if kind == "third_octave":
+            return bands.bands_chart(
+                self.third_octave,
+                axes=self.axes,
+                title=f"1/3-octave band RMS vs {self.requirement}",
+                verdict_range_hz=self.verdict_range_hz,
+            )
+        if kind == "psd":
+            return spectra.psd_chart(self.spectrum, axes=self.axes)
+        if kind == "integrated":
+            pims = self.transient_basis == "pims" and self.integrated_pims is not None
+            integ = self.integrated_pims if pims else self.integrated_sliding
+            return histories.integrated_chart(integ, axes=self.axes)  # type: ignore[arg-type]
+        raise InputError(
+            f"unknown chart {kind!r}", where="kind", fix="use third_octave, psd or integrated"
+        )
+
 
 def assess(
     timepts: np.ndarray,

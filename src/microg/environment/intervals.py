@@ -185,6 +185,12 @@ class IntervalBandRMS:
 
         return plot_interval_percentiles(self, row=row, ax=ax)
 
+    def plot_interactive(self, row: str = "rss") -> Any:
+        """The percentiles against the limit as an interactive chart (a plotly Figure)."""
+        from microg.plotting.interactive.bands import percentiles_chart
+
+        return percentiles_chart(self, row=row)
+
 
 @dataclass(frozen=True)
 class IntervalStats:
@@ -242,6 +248,12 @@ class IntervalStats:
 
         return plot_interval_stats(self, ax=ax)
 
+    def plot_interactive(self) -> Any:
+        """Interval min, max and mean as an interactive chart (a plotly Figure, micro-g)."""
+        from microg.plotting.interactive.histories import interval_stats_chart
+
+        return interval_stats_chart(self)
+
 
 @dataclass(frozen=True)
 class BandLimitedRMS:
@@ -298,6 +310,12 @@ class BandLimitedRMS:
         from microg.plotting.intervals import plot_band_limited_rms
 
         return plot_band_limited_rms(self, ax=ax)
+
+    def plot_interactive(self) -> Any:
+        """Band-limited RMS against time as an interactive chart (a plotly Figure, micro-g)."""
+        from microg.plotting.interactive.histories import band_limited_chart
+
+        return band_limited_chart(self)
 
 
 @dataclass(frozen=True)
@@ -357,6 +375,12 @@ class Spectrogram:
 
         return plot_spectrogram(self, axis=axis, ax=ax)
 
+    def plot_interactive(self, axis: str | None = None) -> Any:
+        """The spectrogram of one axis as an interactive heat map (a plotly Figure)."""
+        from microg.plotting.interactive.spectra import spectrogram_chart
+
+        return spectrogram_chart(self, axis=axis)
+
 
 @dataclass(frozen=True)
 class CumulativeRMS:
@@ -414,6 +438,12 @@ class CumulativeRMS:
         from microg.plotting.intervals import plot_cumulative_rms
 
         return plot_cumulative_rms(self, ax=ax)
+
+    def plot_interactive(self) -> Any:
+        """Cumulative RMS as an interactive chart (a plotly Figure, micro-g)."""
+        from microg.plotting.interactive.spectra import cumulative_chart
+
+        return cumulative_chart(self)
 
 
 @dataclass(frozen=True)
@@ -502,6 +532,10 @@ class IntervalAnalysis:
         ``ax``: the matplotlib axes to draw into (default: a new figure).
         """
         return self.bands.plot(row=row, ax=ax)
+
+    def plot_interactive(self, row: str = "rss") -> Any:
+        """The percentiles of interval band RMS as an interactive chart (a plotly Figure)."""
+        return self.bands.plot_interactive(row=row)
 
 
 def _interval_spectrum(

@@ -189,6 +189,12 @@ class BandOverlay:
 
         return plot_band_overlay(self, ax=ax)
 
+    def plot_interactive(self) -> Any:
+        """Predicted and measured band RMS as an interactive chart (a plotly Figure)."""
+        from microg.plotting.interactive.bands import overlay_chart
+
+        return overlay_chart(self)
+
 
 def band_overlay(
     prediction: dict[str, Any],

@@ -411,6 +411,12 @@ class QuasiSteadyResult:
 
         return plot_quasi_steady_map(self, ax=ax)
 
+    def plot3d(self) -> Any:
+        """The peak magnitude at the structure's samples in 3-D (a plotly Figure, micro-g)."""
+        from microg.plotting.interactive.maps import quasi_steady_3d
+
+        return quasi_steady_3d(self)
+
     def to_xarray(self) -> Any:
         """Per-point vectors (orbital averages, m/s^2) as an xarray Dataset."""
         import xarray as xr

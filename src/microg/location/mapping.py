@@ -274,6 +274,17 @@ class AccelerationMap:
 
         return plot_map(self, measure=measure, title=title, best=best, ax=ax)
 
+    def plot3d(
+        self, *, measure: str = "total", title: str | None = None, best: Location | None = None
+    ) -> Any:
+        """The map coloured along the structure in 3-D (a plotly Figure).
+
+        See :func:`microg.plotting.interactive.maps.acceleration_map_3d`.
+        """
+        from microg.plotting.interactive.maps import acceleration_map_3d
+
+        return acceleration_map_3d(self, measure=measure, best=best, title=title)
+
 
 @dataclass(frozen=True)
 class Location:

@@ -133,6 +133,14 @@ class LocateResult:
             ax=ax,
         )
 
+    def plot3d(self, *, title: str | None = None) -> Any:
+        """The map coloured along the structure in 3-D, the best location ringed (plotly)."""
+        return self.amap.plot3d(
+            measure=self.best.measure,
+            title=title or f"{self.model}: peak acceleration ({self.best.measure}) in 3-D",
+            best=self.best,
+        )
+
 
 def default_point(station: Station, kind: str, where: str) -> str:
     """The model's first named point of ``kind`` (``"crew"``, ``"experiment"``).

@@ -18,9 +18,11 @@ if TYPE_CHECKING:
     from microg.analysis import Analysis
 
 __all__ = [
+    "OBSERVATION_CHARTS",
     "figure_builders",
     "figure_names",
     "figures",
+    "interactive_charts",
     "interactive_model",
     "render_analysis",
     "report_files",
@@ -162,10 +164,44 @@ def report_files(
 
 
 def interactive_model(result: Analysis) -> str:
-    """The 3-D model and mode-shape slider as an HTML fragment, plotly.js inlined once."""
-    from microg.plotting.interactive import plotly_html
+    """The 3-D model and mode-shape slider as an HTML fragment (plotly.js is in the head)."""
+    from microg.report.html import chart_fragment
 
-    return plotly_html(result.plot3d(), div_id="model3d", include_plotlyjs=True)
+    return chart_fragment(result.plot3d(), div_id="model3d")
+
+
+#: the interactive charts standing for an observed point's PNG figure (by the figure's kind)
+OBSERVATION_CHARTS = {
+    "bands": ("history", "bands"),
+    "psd": ("psd",),
+    "integrated": ("integrated",),
+}
+
+
+def interactive_charts(result: Analysis) -> dict[str, list[str]]:
+    """Each observed point's interactive charts as HTML fragments, by the PNG they stand for.
+
+    ``{s}-bands.png`` (history and bands) -> the history and band charts; ``{s}-psd.png`` ->
+    the PSD; ``{s}-integrated.png`` -> the 10-s integrated acceleration.  Element ids are
+    ``chart-N``, unique in the page.
+
+    Parameters
+    ----------
+    result : Analysis
+    """
+    from microg.report.html import chart_fragment
+
+    out: dict[str, list[str]] = {}
+    stems = figure_names(list(result.observations))
+    n = 0
+    for name, ob in result.observations.items():
+        for png, kinds in OBSERVATION_CHARTS.items():
+            frags = []
+            for kind in kinds:
+                n += 1
+                frags.append(chart_fragment(ob.plot_interactive(kind), div_id=f"chart-{n}"))
+            out[f"{stems[name]}-{png}.png"] = frags
+    return out
 
 
 @lru_cache(maxsize=1)
@@ -193,23 +229,30 @@ def render_analysis(
     summary : dict, optional
         ``result.to_dict()``, if the caller has it already.
     static : bool
-        Leave out the interactive 3-D view (PNG figures only).
+        PNG figures only: no interactive 3-D view or chart, no plotly.js.  Otherwise each
+        figure with an interactive chart (:func:`interactive_charts`) is shown as the chart,
+        its PNG left to the run directory.
     """
     from microg import __version__
-    from microg.report.html import png_data_uri
+    from microg.report.html import plotly_js, png_data_uri
 
     data = to_jsonable(result.to_dict() if summary is None else summary)
-    uris = {k: png_data_uri(v) for k, v in figs.items()}
+    charts = {} if static else interactive_charts(result)
+    uris = {k: png_data_uri(v) for k, v in figs.items() if k not in charts}
     stems = figure_names(list(result.observations))
     obs = []
     for name in result.observations:
         s = stems[name]
-        keys = ["bands", "psd", "integrated", "isolated"]
+        keys = [f"{s}-{k}.png" for k in ("bands", "psd", "integrated", "isolated")]
         obs.append(
             {
                 "name": name,
                 "data": data["observations"][name],
-                "figs": [uris[f"{s}-{k}.png"] for k in keys if f"{s}-{k}.png" in uris],
+                "figs": [
+                    {"file": k, "png": uris.get(k), "charts": charts.get(k)}
+                    for k in keys
+                    if k in figs
+                ],
             }
         )
     vib = []
@@ -243,5 +286,6 @@ def render_analysis(
             forces_fig=uris.get("forces.png"),
             modes_fig=uris["modes.png"],
             model3d=None if static else interactive_model(result),
+            plotlyjs=None if static else plotly_js(),
         )
     )

@@ -12,7 +12,7 @@ from __future__ import annotations
 import base64
 import contextlib
 from functools import lru_cache
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from jinja2 import (
     BytecodeCache,
@@ -30,12 +30,40 @@ from microg._io import to_jsonable
 if TYPE_CHECKING:  # the seed reproduction loads only for its own report (~0.1 s)
     from microg.seed.reproduce import Reproduction
 
-__all__ = ["render_reproduction", "environment", "id_ranges", "png_data_uri"]
+__all__ = [
+    "chart_fragment",
+    "environment",
+    "id_ranges",
+    "plotly_js",
+    "png_data_uri",
+    "render_reproduction",
+]
 
 
 def png_data_uri(png: bytes) -> str:
     """A ``data:image/png;base64,...`` URI for embedding ``png`` in HTML."""
     return "data:image/png;base64," + base64.b64encode(png).decode("ascii")
+
+
+@lru_cache(maxsize=1)
+def plotly_js() -> str:
+    """plotly.js itself (~4.8 MB), inlined once in a page's head: the page works offline."""
+    from plotly.offline import get_plotlyjs
+
+    return str(get_plotlyjs())
+
+
+def chart_fragment(fig: Any, div_id: str) -> str:
+    """A plotly figure as an HTML fragment for a page whose head inlines :func:`plotly_js`.
+
+    Parameters
+    ----------
+    fig : plotly.graph_objects.Figure
+    div_id : the figure's element id, unique in the page
+    """
+    from microg.plotting.interactive import plotly_html
+
+    return plotly_html(fig, div_id=div_id, include_plotlyjs=False)
 
 
 def id_ranges(ids: list[str]) -> list[tuple[str, str]]:

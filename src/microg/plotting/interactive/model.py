@@ -1,4 +1,4 @@
-"""Interactive 3-D view of a model and its modes (plotly), for notebooks and the HTML report.
+"""The model in 3-D and its modes (plotly), for notebooks and the HTML report.
 
 The structure's samples are drawn as lines (each beam or body along itself, broken between
 components), the named points as labelled markers, force points in red with a cone along the
@@ -25,7 +25,7 @@ if TYPE_CHECKING:
 
     from microg.dynamics.modes import Modes
 
-__all__ = ["MAX_FRAMES", "MAX_SAMPLES", "modes_3d", "plotly_html"]
+__all__ = ["MAX_FRAMES", "MAX_SAMPLES", "modes_3d"]
 
 #: largest number of samples drawn as lines; more are decimated per component
 MAX_SAMPLES = 4000
@@ -262,23 +262,3 @@ def modes_3d(
             }
         ]
     return go.Figure(data=traces, frames=frames, layout=layout)
-
-
-def plotly_html(fig: go.Figure, *, div_id: str, include_plotlyjs: bool) -> str:
-    """A figure as an HTML fragment (plotly.js inlined when ``include_plotlyjs``: once a page).
-
-    Parameters
-    ----------
-    fig : plotly.graph_objects.Figure
-    div_id : the element id of the figure in the page
-    include_plotlyjs : inline plotly.js (the page then works offline)
-    """
-    return str(
-        fig.to_html(
-            full_html=False,
-            include_plotlyjs=include_plotlyjs,
-            div_id=div_id,
-            config={"displaylogo": False, "responsive": True},
-            auto_play=False,
-        )
-    )
