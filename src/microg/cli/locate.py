@@ -375,7 +375,7 @@ def locate(
         png = png_bytes(result.plot())
         command = " ".join(["microg", *sys.argv[1:]]) if sys.argv else "microg locate"
         html = render_locate(result, png, static=static, command=command)
-        files = {"map.json": text, "map.png": png, "report.html": html}
+        files: dict[str, bytes | str] = {"map.json": text, "map.png": png, "report.html": html}
         path = write_output_files(out_dir, files, where="--out")
     if as_json:
         click.echo(text)
