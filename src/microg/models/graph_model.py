@@ -250,11 +250,11 @@ class ShellSection:
     """
 
     name: str
-    membrane_N_per_m: np.ndarray
-    bending_N_m: np.ndarray
-    shear_N_per_m: np.ndarray
+    membrane_N_per_m: np.ndarray  # noqa: N815 - SI unit suffix
+    bending_N_m: np.ndarray  # noqa: N815 - SI unit suffix
+    shear_N_per_m: np.ndarray  # noqa: N815 - SI unit suffix
     mass_per_area_kg_per_m2: float
-    drilling_N_per_m: float = 0.0
+    drilling_N_per_m: float = 0.0  # noqa: N815 - SI unit suffix
 
 
 @dataclass(frozen=True)
