@@ -5,7 +5,8 @@ shells :mod:`microg.structure.shells`) of every beam, rod, shell, spring, scalar
 scalar mass and concentrated mass of a :class:`~microg.models.graph_model.GraphModel`,
 rotates them to the basic frame (beam end offsets as rigid links, skew sections about their
 principal axes, pin flags released) and sums them into sparse stiffness, mass and damping
-matrices (the g-set); the rigid elements are resolved into the transformation to the independent DOFs (:mod:`microg.structure.links`).
+matrices (the g-set); the rigid elements are resolved into the transformation to the
+independent DOFs (:mod:`microg.structure.links`).
 :func:`microg.structure.frame.build_frame` makes the structure from these.
 """
 
