@@ -284,7 +284,7 @@ def assemble_frame(graph: GraphModel, *, mass: str | None = None) -> FrameMatric
         if sh:
             ids = np.array([[index[nd] for nd in e.nodes] for e in sh])
             sec = [e.section for e in sh]
-            ks, ms = shell_matrices(
+            ks, mshell = shell_matrices(
                 P[ids],
                 np.array([q.membrane_N_per_m for q in sec], float),
                 np.array([q.bending_N_m for q in sec], float),
@@ -296,7 +296,7 @@ def assemble_frame(graph: GraphModel, *, mass: str | None = None) -> FrameMatric
             )
             dofs = (6 * ids[:, :, None] + np.arange(6)).reshape(len(sh), -1)
             _scatter(dofs, ks, rk, ck, vk)
-            _scatter(dofs, ms, rm, cm, vm)
+            _scatter(dofs, mshell, rm, cm, vm)
 
     for s in graph.springs:
         ia = index[s.nodes[0]]
