@@ -278,7 +278,7 @@ def test_fixture_deck_cards_and_ignored_ones():
     g = load_bdf(FIXTURE / "beam_modes.dat", units="in, lbf, s")
     assert len(g.nodes) == 12 and len(g.beams) == 10 and len(g.masses) == 1
     assert g.meta["ignored_cards"] == {"EIGRL": 1, "USET": 1}
-    assert "K6ROT" in g.meta["params_ignored"]
+    assert "K6ROT" not in g.meta["params_ignored"]  # read: it scales the shells' drilling
     assert any("K6ROT" in w for w in g.meta["warnings"])
 
 
@@ -294,10 +294,10 @@ def _one_line(exc: pytest.ExceptionInfo, *parts: str) -> str:
 
 
 def test_unsupported_cards_listed_by_name_and_count(tmp_path):
-    text = BASE + "CQUAD4,5,20,1,2,2,1\nCQUAD4,6,20,1,2,2,1\nPSHELL,20,1,0.1\nMAT8,3,1.\n"
+    text = BASE + "CHEXA,5,20,1,2,2,1\nCHEXA,6,20,1,2,2,1\nPSOLID,20,1\nMAT8,3,1.\n"
     with pytest.raises(InputError) as exc:
         load_bdf(_deck(tmp_path, text), units="m, N, s")
-    _one_line(exc, "deck.bdf", "unsupported cards: CQUAD4 (2), MAT8 (1), PSHELL (1)", "GRID")
+    _one_line(exc, "deck.bdf", "unsupported cards: CHEXA (2), MAT8 (1), PSOLID (1)", "GRID")
 
 
 def test_an_included_file_that_is_not_a_deck_is_never_echoed(tmp_path):
@@ -358,10 +358,10 @@ def test_cli_exit_status_two_for_a_bad_deck(tmp_path, capsys):
     # library's InputError)
     from microg.cli import main
 
-    deck = _deck(tmp_path, BASE + "CQUAD4,5,20,1,2,2,1\n")
+    deck = _deck(tmp_path, BASE + "CHEXA,5,20,1,2,2,1\n")
     assert main(["modes", str(deck), "--units", "m, N, s"]) == 2
     err = capsys.readouterr().err.strip()
-    assert "\n" not in err and "unsupported cards: CQUAD4 (1)" in err
+    assert "\n" not in err and "unsupported cards: CHEXA (1)" in err
     assert main(["modes", str(_deck(tmp_path, BASE, "ok.bdf"))]) == 2
     assert "units" in capsys.readouterr().err
     bad = {

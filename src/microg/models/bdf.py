@@ -11,8 +11,9 @@ the cards into the graph; :mod:`microg.models.bdf_properties` reads the property
 material cards.
 
 **Cards converted:** GRID (CP, CD), CORD2R/C/S, CBAR, CBEAM, BAROR, BEAMOR, PBAR, PBARL,
-PBEAM (uniform), PBEAML (uniform), CROD, PROD, CONROD, CBUSH + PBUSH (K, B, GE), CONM2,
-CONM1 (a rigid body's 6x6 mass), MAT1, PARAM (WTMASS, COUPMASS; K6ROT noted); and through
+PBEAM (uniform), PBEAML (uniform), CROD, PROD, CONROD, CQUAD4, CTRIA3 + PSHELL
+(:mod:`microg.models.bdf_shells`), CBUSH + PBUSH (K, B, GE), CONM2,
+CONM1 (a rigid body's 6x6 mass), MAT1, PARAM (WTMASS, COUPMASS, K6ROT); and through
 :mod:`microg.models.bdf_constraints`: SPOINT, CELAS1 + PELAS, CELAS2, CMASS1 + PMASS, CMASS2,
 CDAMP1 + PDAMP, CDAMP2, RBE2, RBE3 (rotations, UM), MPC, MPCADD (``MPC = n`` applied), SPC,
 SPC1, SPCADD (noted as constraints).
@@ -64,6 +65,7 @@ from microg.models.bdf_properties import (
     material,
     materials,
 )
+from microg.models.bdf_shells import K6ROT_DEFAULT, SHELL_CARDS, shell_elements
 from microg.models.coords import (
     NASTRAN_KINDS,
     CoordinateFrame,
@@ -109,6 +111,7 @@ SUPPORTED_CARDS = (
     "PBEAM", "PBEAML", "CROD", "PROD", "CONROD", "CBUSH", "PBUSH", "CELAS1", "CELAS2", "PELAS",
     "CONM2", "CONM1", "RBE2", "RBE3", "MAT1", "PARAM", "SPC", "SPC1", "SPCADD",
     "SPOINT", "CMASS1", "CMASS2", "PMASS", "CDAMP1", "CDAMP2", "PDAMP", "MPC", "MPCADD",
+    *SHELL_CARDS,
 )
 # fmt: on
 # fmt: off
@@ -128,7 +131,8 @@ IGNORED_CARDS = (
     "CHBDYP", "PHBDY", "QBDY1", "QBDY2", "QBDY3", "QVOL", "QHBDY", "TEMPP1", "TEMPRB",
     # material and load tables, sets, design optimisation, initial conditions
     "TABLEM1", "TABLEM2", "TABLEM3", "TABLEM4", "TABLES1", "TABLEST", "SET1", "SET3",
-    "DESVAR", "DRESP1", "DRESP2", "DCONSTR", "DVPREL1", "DOPTPRM", "TIC",
+    "DESVAR", "DRESP1", "DRESP2", "DCONSTR", "DVPREL1", "DOPTPRM", "TIC", "DCONADD", "DSCREEN",
+    "DVGRID",
 )
 # fmt: on
 
@@ -243,10 +247,7 @@ class _Deck:
             if lumped
             else f"PARAM,COUPMASS,{coupmass.raw(2) if coupmass else ''} in the deck"
         )
-        if "K6ROT" in params:
-            self.warnings.append(
-                "PARAM K6ROT noted: it stiffens shell drilling rotations only; no shells here"
-            )
+        k6 = params["K6ROT"].real(2, "K6ROT", K6ROT_DEFAULT) if "K6ROT" in params else None
         frames = self.frames()
         nodes, grid_pos, grid_axes = self.grids(frames)
         nodes = self.with_scalar_points(nodes)
@@ -256,6 +257,14 @@ class _Deck:
         )
         beams = self.beams(beam_props, mats, grid_pos, grid_axes, wt)
         rods = self.rods(mats, grid_pos, wt)
+        shell_cards = self.by_id(("CQUAD4", "CTRIA3"), "element")
+        shells = shell_elements(
+            shell_cards, self.by_id(("PSHELL",), "shell property"), mats,
+            lambda g, c, lab: self.grid(g, c, grid_pos, lab), self.sc, wt,
+            K6ROT_DEFAULT if k6 is None else k6, self.origin,
+        )  # fmt: skip
+        if k6 is not None and not shells:
+            self.warnings.append("PARAM K6ROT noted: it stiffens shell drilling rotations only")
         springs = self.bushes(grid_pos, grid_axes, frames)
         scalars = bdf_constraints.scalar_springs(self) + bdf_constraints.scalar_dampers(self)
         masses = self.conm2(grid_pos, frames, wt) + self.conm1(grid_pos, frames, wt)
@@ -264,13 +273,14 @@ class _Deck:
         constraints = bdf_constraints.constraints(self, grid_pos)
         for ps_node, comps in self.grid_ps:
             constraints.append(Constraint(ps_node, comps))
-        ignored_params = sorted(k for k in params if k not in ("WTMASS", "COUPMASS"))
+        ignored_params = sorted(k for k in params if k not in ("WTMASS", "COUPMASS", "K6ROT"))
         meta = {
             "format": "nastran-bdf",
             "units": {"length_m": self.sc.length, "force_N": self.sc.force, "time_s": self.sc.time},
             "wtmass": wt,
             "mass_formulation": formulation,
             "mass_formulation_note": f"{formulation} ({chosen_by}; {MASS_NOTES[formulation]})",
+            "k6rot": (K6ROT_DEFAULT if k6 is None else k6) if shells else None,
             "ignored_cards": ignored,
             "params_ignored": ignored_params,
             "card_counts": dict(counts),
@@ -284,6 +294,7 @@ class _Deck:
             nodes=tuple(nodes),
             beams=tuple(beams),
             rods=tuple(rods),
+            shells=tuple(shells),
             springs=tuple(springs),
             scalar_springs=tuple(scalars),
             masses=tuple(masses),

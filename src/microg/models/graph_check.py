@@ -23,6 +23,7 @@ from microg.models.graph_model import (
     ZERO_LENGTH_TOL,
     BeamSection,
     GraphModel,
+    ShellSection,
     nearest_names,
     parse_components,
 )
@@ -56,6 +57,7 @@ def validate_graph(graph: GraphModel) -> None:
         ("node", graph.nodes),
         ("beam", graph.beams),
         ("rod", graph.rods),
+        ("shell", graph.shells),
         ("spring", graph.springs),
         ("scalar spring", graph.scalar_springs),
         ("scalar mass", graph.scalar_masses),
@@ -174,6 +176,14 @@ def validate_graph(graph: GraphModel) -> None:
                 where=f"{src}: {r.name}",
                 fix="connect two distinct nodes, or use a spring (CBUSH/CELAS)",
             )
+    for sh in graph.shells:
+        if len(sh.nodes) not in (3, 4) or len(set(sh.nodes)) != len(sh.nodes):
+            raise InputError("a shell needs 3 or 4 distinct nodes", where=f"{src}: {sh.name}")
+        for nd in sh.nodes:
+            ref(nd, sh.name)
+        if id(sh.section) not in checked:
+            _check_shell_section(sh.section, f"{src}: {sh.name}")
+            checked.add(id(sh.section))
     for sp_ in graph.springs:
         spatial_ref(sp_.nodes[0], sp_.name)
         spatial_ref(sp_.nodes[1], sp_.name)
@@ -266,6 +276,29 @@ def validate_graph(graph: GraphModel) -> None:
             where=f"{src}: constraint on {c.node}",
             allowed="1" if c.node in scalar else "123456",
         )
+
+
+def _check_shell_section(s: ShellSection, where: str) -> None:
+    for mat, shape, what in (
+        (s.membrane_N_per_m, (3, 3), "membrane"),
+        (s.bending_N_m, (3, 3), "bending"),
+        (s.shear_N_per_m, (2, 2), "transverse shear"),
+    ):
+        a = np.asarray(mat, float)
+        if a.shape != shape or not np.all(np.isfinite(a)):
+            raise InputError(
+                f"section {s.name!r}: {what} matrix must be finite {shape}", where=where
+            )
+        big = max(float(np.max(np.abs(a))), 1e-300)
+        if np.max(np.abs(a - a.T)) > 1e-12 * big or np.linalg.eigvalsh(a).min() < -1e-9 * big:
+            raise InputError(
+                f"section {s.name!r}: {what} matrix is not symmetric positive semidefinite",
+                where=where,
+            )
+    if not (math.isfinite(s.mass_per_area_kg_per_m2) and s.mass_per_area_kg_per_m2 >= 0):
+        raise InputError(f"section {s.name!r}: negative mass per area", where=where)
+    if not (math.isfinite(s.drilling_N_per_m) and s.drilling_N_per_m >= 0):
+        raise InputError(f"section {s.name!r}: negative drilling stiffness", where=where)
 
 
 def _check_section(s: BeamSection, where: str) -> None:

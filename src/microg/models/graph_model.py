@@ -62,6 +62,8 @@ __all__ = [
     "RodElement",
     "ScalarMass",
     "ScalarSpring",
+    "ShellElement",
+    "ShellSection",
     "Spring",
     "default_orientation",
     "nearest_names",
@@ -221,6 +223,56 @@ class RodElement:
     ea_N: float  # noqa: N815 - SI unit suffix
     gj_N_m2: float  # noqa: N815 - SI unit suffix
     mass_per_length_kg_per_m: float
+
+
+@dataclass(frozen=True)
+class ShellSection:
+    """Stiffness and mass of a uniform shell (a NASTRAN PSHELL with MAT1), per unit area.
+
+    Resultants in the element axes (x, y in the mid-plane, z the normal):
+    ``[Nx, Ny, Nxy] = A [ex, ey, gxy]``, ``[Mx, My, Mxy] = D [kx, ky, kxy]``,
+    ``[Qx, Qy] = S [gxz, gyz]``; isotropic matrices (any in-plane axes give the same).
+
+    Attributes
+    ----------
+    name : str
+    membrane_N_per_m : ndarray (3, 3)
+        ``A`` (MID1 times T), N/m; zeros: no membrane stiffness.
+    bending_N_m : ndarray (3, 3)
+        ``D`` (MID2 times 12I/T^3 T^3 / 12), N m; zeros: no bending stiffness.
+    shear_N_per_m : ndarray (2, 2)
+        ``S`` (MID3's G times TS/T T), N/m.
+    mass_per_area_kg_per_m2 : float
+        ``rho T + NSM``, kg/m^2 (>= 0); translational only.
+    drilling_N_per_m : float
+        Penalty ``alpha`` on the drilling rotation, ``alpha (theta_z - omega)^2 / 2`` per
+        area, ``omega`` the membrane's rotation (NASTRAN ``1e-6 K6ROT G T``), N/m.
+    """
+
+    name: str
+    membrane_N_per_m: np.ndarray  # noqa: N815 - SI unit suffix
+    bending_N_m: np.ndarray  # noqa: N815 - SI unit suffix
+    shear_N_per_m: np.ndarray  # noqa: N815 - SI unit suffix
+    mass_per_area_kg_per_m2: float
+    drilling_N_per_m: float = 0.0  # noqa: N815 - SI unit suffix
+
+
+@dataclass(frozen=True)
+class ShellElement:
+    """A flat three- or four-node shell (NASTRAN CTRIA3 or CQUAD4).
+
+    Attributes
+    ----------
+    name : str
+        ``"cquad4:7"``.
+    nodes : tuple of str
+        Three (triangle) or four (quadrilateral) corner nodes, in order around the element.
+    section : ShellSection
+    """
+
+    name: str
+    nodes: tuple[str, ...]
+    section: ShellSection
 
 
 @dataclass(frozen=True)
@@ -432,7 +484,7 @@ class GraphModel:
     ----------
     name : str
     nodes : tuple of Node
-    beams, rods, springs, scalar_springs, masses, rigid_links, interpolations : tuples
+    beams, rods, shells, springs, scalar_springs, masses, rigid_links, interpolations : tuples
         The elements.
     scalar_masses : tuple of ScalarMass
     mpcs : tuple of MultiPointConstraint
@@ -453,6 +505,7 @@ class GraphModel:
     nodes: tuple[Node, ...]
     beams: tuple[BeamElement, ...] = ()
     rods: tuple[RodElement, ...] = ()
+    shells: tuple[ShellElement, ...] = ()
     springs: tuple[Spring, ...] = ()
     scalar_springs: tuple[ScalarSpring, ...] = ()
     masses: tuple[ConcentratedMass, ...] = ()

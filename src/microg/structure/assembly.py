@@ -1,11 +1,12 @@
 """Assembly of a graph model's element matrices on 6 basic-frame DOFs per node.
 
-:func:`assemble_frame` evaluates the element kernels (:mod:`microg.structure.elements`) of
-every beam, rod, spring, scalar spring, scalar mass and concentrated mass of a
-:class:`~microg.models.graph_model.GraphModel`, rotates them to the basic frame (beam end
-offsets as rigid links, skew sections about their principal axes, pin flags released) and
-sums them into sparse stiffness, mass and damping matrices (the g-set); the rigid elements
-are resolved into the transformation to the independent DOFs (:mod:`microg.structure.links`).
+:func:`assemble_frame` evaluates the element kernels (:mod:`microg.structure.elements`;
+shells :mod:`microg.structure.shells`) of every beam, rod, shell, spring, scalar spring,
+scalar mass and concentrated mass of a :class:`~microg.models.graph_model.GraphModel`,
+rotates them to the basic frame (beam end offsets as rigid links, skew sections about their
+principal axes, pin flags released) and sums them into sparse stiffness, mass and damping
+matrices (the g-set); the rigid elements are resolved into the transformation to the
+independent DOFs (:mod:`microg.structure.links`).
 :func:`microg.structure.frame.build_frame` makes the structure from these.
 """
 
@@ -35,6 +36,7 @@ from microg.structure.elements import (
     shear_parameter,
 )
 from microg.structure.links import link_transform
+from microg.structure.shells import shell_matrices
 
 if TYPE_CHECKING:  # scipy loads on first use (see microg.structure.fem)
     import scipy.sparse as sp
@@ -276,6 +278,25 @@ def assemble_frame(graph: GraphModel, *, mass: str | None = None) -> FrameMatric
         dofs = np.concatenate([6 * a[:, None] + np.arange(6), 6 * b_[:, None] + np.arange(6)], 1)
         _scatter(dofs, At @ kl @ A, rk, ck, vk)
         _scatter(dofs, At @ ml @ A, rm, cm, vm)
+
+    for k in (4, 3):  # shells (CQUAD4, CTRIA3): microg.structure.shells
+        sh = [e for e in graph.shells if len(e.nodes) == k]
+        if sh:
+            ids = np.array([[index[nd] for nd in e.nodes] for e in sh])
+            sec = [e.section for e in sh]
+            ks, mshell = shell_matrices(
+                P[ids],
+                np.array([q.membrane_N_per_m for q in sec], float),
+                np.array([q.bending_N_m for q in sec], float),
+                np.array([q.shear_N_per_m for q in sec], float),
+                np.array([q.drilling_N_per_m for q in sec], float),
+                np.array([q.mass_per_area_kg_per_m2 for q in sec], float),
+                lumped,
+                [graph.source + ": " + e.name if graph.source else e.name for e in sh],
+            )
+            dofs = (6 * ids[:, :, None] + np.arange(6)).reshape(len(sh), -1)
+            _scatter(dofs, ks, rk, ck, vk)
+            _scatter(dofs, mshell, rm, cm, vm)
 
     for s in graph.springs:
         ia = index[s.nodes[0]]

@@ -514,6 +514,7 @@ def build_frame(
         "n_nodes": len(graph.nodes),
         "n_elements": len(graph.beams)
         + len(graph.rods)
+        + len(graph.shells)
         + len(graph.springs)
         + len(graph.scalar_springs),
         "n_masses": len(graph.masses),
