@@ -97,3 +97,26 @@ def test_include_cycle_and_depth_are_one_line_errors(tmp_path):
     # one level less is read
     cards, _ = read_cards(_deck(tmp_path, "INCLUDE 'd2.blk'\n", "ok.bdf"))
     assert [c.name for c in cards] == ["GRID"]
+
+
+def test_a_short_free_field_line_before_its_continuation_is_padded(tmp_path):
+    # each free-field line stands for one fixed-format line (QRG, "Free Field Format"): the
+    # continuation's first data field is PA whatever the first line held, so this CBAR has
+    # PA and PB blank and W1A = 1; unpadded, the 1 became PA, a pin flag (a silent misread).
+    # Reference: the same card in fixed format, whose columns leave no doubt.
+    free = tmp_path / "free.dat"
+    free.write_text("BEGIN BULK\nCBAR,1,1,1,2,0.,1.\n,,,1.\nGRID*,3,,1.\n*,2.\nENDDATA\n")
+    fixed = tmp_path / "fixed.dat"
+    fixed.write_text(
+        "BEGIN BULK\n"
+        + "CBAR    1       1       1       2       0.      1.                      +\n"
+        + "+                       1.\n"
+        + "GRID*   3                               1.                              *\n"
+        + "*       2.\n"
+        + "ENDDATA\n"
+    )
+    (got, _), (want, _) = read_cards(free), read_cards(fixed)
+    assert [c.fields for c in got] == [c.fields for c in want]
+    bar = got[0].fields
+    assert bar[9] is None and bar[10] is None and bar[11] == 1.0  # PA, PB blank; W1A = 1
+    assert got[1].fields[:5] == ("GRID", 3, None, 1.0, None) and got[1].fields[5] == 2.0

@@ -204,7 +204,13 @@ def _read_lines(
 
 
 def _free(parts: list[str], large: bool, where: str) -> list[str]:
-    """Data fields of a free-field line (after its first field): 8 (4 large), then a marker."""
+    """Data fields of a free-field line (after its first field): 8 (4 large), then a marker.
+
+    A short line is padded with blank fields to its 8 (4): each line of a free-field card
+    stands for one fixed-format line, so a continuation's first data field is field 2 of the
+    next line whatever the line before it held (MSC/NX Quick Reference Guide, "Free Field
+    Format").
+    """
     per = 4 if large else 8
     data = parts[1:]
     if len(data) > per + 1 or (len(data) == per + 1 and isinstance(_value(data[per]), int | float)):
@@ -214,7 +220,7 @@ def _free(parts: list[str], large: bool, where: str) -> list[str]:
             where=where,
             fix="continue the card on a new line starting with '+' (or ',')",
         )
-    return data[:per]
+    return data[:per] + [""] * (per - len(data[:per]))
 
 
 def _fields_of(line: str, where: str) -> tuple[str, list[str]]:
