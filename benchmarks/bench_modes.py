@@ -11,7 +11,7 @@ Solvers, each on the same matrices, for ``--modes`` 30 and 300 (rigid included):
   tree flexibility (no factorisation), ARPACK on ``G_e M`` (its inverse-form Ritz pairs,
   M-orthonormalised), residual checks, effective masses;
 * ``cholmod`` (the strongest baseline): ``eigsh(K, k, M, sigma, OPinv=CHOLMOD(K - sigma M))``
-  with scikit-sparse's supernodal Cholesky (the ``bench`` extra; when scikit-sparse is not
+  with scikit-sparse's supernodal Cholesky (the ``cholmod`` extra; when scikit-sparse is not
   installed the table says so and falls back to ``splu``);
 * ``splu``: the same with SuperLU and a symmetric ordering (MMD on A^T + A).
 
