@@ -1,9 +1,12 @@
 """Benchmark of the isolation kernels against strong baselines run in the same process.
 
-1. The M_a kernel (Eq. 4.3) on a 4-D grid (20 k x 20 mu x 10 zeta x 2500 r = 10^7 points)
-   against a BATCHED numpy solve of the 2x2 complex system of Eq. 4.3 (``numpy.linalg.solve``
-   on stacked matrices, chunked over k so the stack fits in memory) -- the best a plain numpy
-   user would write; no per-point Python loop.
+1. The M_a kernel (Eq. 4.3) on a 4-D grid (20 k x 20 mu x 10 zeta x 2500 r = 10^7 points),
+   microg's cache-blocked grid kernel (``accel_magnification_grid``, 1 thread), against the
+   strongest of: microg's own closed form by plain broadcasting (``accel_magnification``, the
+   same real formula ``M_a^2 = (a^2 + t)/(D_r^2 + t b^2)`` without blocking), a fused numba
+   loop of that formula (the ``bench`` extra: one pass, no temporaries), and a batched
+   ``numpy.linalg.solve`` of the 2x2 complex system (secondary row: what a numpy user without
+   the closed form would write).
 2. The exact first-order-hold package response (``package_response``) on 10^6 samples against a
    sequential FOH loop compiled with numba (the ``bench`` extra; skipped without it), the same
    recurrence with the same matrices.  microg takes the diagonal path on every grid (the
@@ -18,15 +21,18 @@
    of order 1e-12..1e-10 (of peak) between the two, at the rounding of the times, not of the
    method.
 
-BLAS is limited to 1 thread for the comparisons.
-Run: ``.venv/bin/python benchmarks/bench_isolation.py [--cpu] [--scans]`` (about 60 s; ``--cpu``
-times this thread's CPU time, for a machine whose cores other processes share).
+BLAS is limited to 1 thread for the comparisons.  Timing: CPU time of this thread
+(``time.thread_time``: the machine's 2 cores are shared, so wall time would count other
+processes), ROUNDS interleaved rounds, the median of each; the threaded grid row is wall time
+(the CPU time of one thread would not count its pool) and only indicative on a shared machine.
+Run: ``.venv/bin/python benchmarks/bench_isolation.py [--scans]`` (about 90 s).
 """
 
 from __future__ import annotations
 
 import importlib.util
 import os
+import statistics
 import time
 from collections.abc import Callable
 from typing import Any
@@ -42,18 +48,50 @@ from microg.isolation.timedomain import (
 )
 from microg.isolation.transmissibility import accel_magnification, accel_magnification_grid
 
-#: the clock: wall time by default; ``--cpu`` takes this thread's CPU time (robust when other
-#: processes share the cores; the multi-threaded grid row then counts the main thread only)
-CLOCK: Callable[[], float] = time.perf_counter
+CLOCK: Callable[[], float] = time.thread_time
+ROUNDS = 5
 
 
-def best_of(fn: Callable[[], Any], repeat: int = 5) -> tuple[float, Any]:
-    times, out = [], None
-    for _ in range(repeat):
-        t0 = CLOCK()
-        out = fn()
-        times.append(CLOCK() - t0)
-    return min(times), out
+def interleaved(
+    fns: dict[str, Callable[[], Any]], rounds: int = ROUNDS
+) -> tuple[dict[str, float], dict[str, Any]]:
+    """Median CPU time of each function over interleaved rounds (s), and each one's result."""
+    times: dict[str, list[float]] = {k: [] for k in fns}
+    outs: dict[str, Any] = {}
+    for _ in range(rounds):
+        for k, f in fns.items():
+            t0 = CLOCK()
+            outs[k] = f()
+            times[k].append(CLOCK() - t0)
+    return {k: statistics.median(v) for k, v in times.items()}, outs
+
+
+def numba_ma() -> Callable[..., np.ndarray] | None:
+    """The closed form of M_a in one fused compiled loop over the grid (None without numba)."""
+    if importlib.util.find_spec("numba") is None:
+        return None
+    import numba  # type: ignore[import-not-found]
+
+    @numba.njit(cache=False)
+    def run(k, mu, zeta, r):  # type: ignore[no-untyped-def]
+        out = np.empty((k.size, mu.size, zeta.size, r.size))
+        q = r * r
+        for i in range(k.size):
+            for j in range(mu.size):
+                s2 = mu[j] * k[i]
+                mu1 = 1.0 + mu[j]
+                for z in range(zeta.size):
+                    t0 = 4.0 * zeta[z] * zeta[z] * s2
+                    for n in range(r.size):
+                        qq = q[n]
+                        a = 1.0 - s2 * qq
+                        b = 1.0 - mu1 * qq
+                        dr = (1.0 - qq) * a - mu[j] * qq
+                        t = t0 * qq
+                        out[i, j, z, n] = np.sqrt((a * a + t) / (dr * dr + t * b * b))
+        return out
+
+    return run  # type: ignore[no-any-return]
 
 
 def batched_solve(k: np.ndarray, mu: np.ndarray, zeta: np.ndarray, r: np.ndarray) -> np.ndarray:
@@ -127,24 +165,49 @@ def main() -> None:
         f"grid {k.size} k x {mu.size} mu x {zeta.size} zeta x {r.size} r = {n:,} points, "
         f"{cpus} CPUs"
     )
-    t_grid, _ = best_of(lambda: accel_magnification_grid(k, mu, zeta, r), repeat=3)
+    t0 = time.perf_counter()
+    accel_magnification_grid(k, mu, zeta, r)
+    t_grid_wall = time.perf_counter() - t0
+    kk, mm, zz = k[:, None, None, None], mu[None, :, None, None], zeta[None, None, :, None]
+    fns: dict[str, Callable[[], Any]] = {
+        "grid kernel (microg), 1 thread": lambda: accel_magnification_grid(
+            k, mu, zeta, r, workers=1
+        ),
+        "closed form by broadcasting (microg)": lambda: accel_magnification(kk, mm, zz, r),
+    }
+    fused = numba_ma()
+    if fused is None:
+        print("numba is not installed (the bench extra): no fused baseline")
+    else:
+        fused(k[:1], mu[:1], zeta[:1], r[:2])  # compile
+        fns["fused numba loop"] = lambda: fused(k, mu, zeta, r)
     with threadpool_limits(1):
-        t_grid1, grid = best_of(
-            lambda: accel_magnification_grid(k, mu, zeta, r, workers=1), repeat=3
+        med, outs = interleaved(fns)
+        med_s, outs_s = interleaved(
+            {"batched linalg.solve": lambda: batched_solve(k, mu, zeta, r)}, 2
         )
-        kk, mm, zz = k[:, None, None, None], mu[None, :, None, None], zeta[None, None, :, None]
-        t_plain, _ = best_of(lambda: accel_magnification(kk, mm, zz, r), repeat=3)
-        t_solve, ref = best_of(lambda: batched_solve(k, mu, zeta, r), repeat=2)
-    err = float(np.max(np.abs(grid - ref) / ref))
-    print(f"{'grid kernel, ' + str(cpus) + ' threads':40s} {t_grid:8.3f} s")
-    print(f"{'grid kernel, 1 thread':40s} {t_grid1:8.3f} s")
-    print(f"{'plain broadcasting kernel, 1 thread':40s} {t_plain:8.3f} s")
-    print(f"{'batched numpy.linalg.solve (baseline)':40s} {t_solve:8.3f} s")
+    med.update(med_s)
+    outs.update(outs_s)
+    mine = outs["grid kernel (microg), 1 thread"]
+    ref = outs["batched linalg.solve"]
     print(
-        f"speed-up over the batched solve: grid kernel {t_solve / t_grid:.3g}x "
-        f"({cpus} threads), {t_solve / t_grid1:.3g}x (1 thread); plain {t_solve / t_plain:.3g}x"
+        f"{'M_a on the grid (CPU time, 1 thread)':40s} {'s':>8s} {'microg/it':>10s} "
+        f"{'max rel diff':>12s}"
     )
-    print(f"max relative difference kernel vs batched solve: {err:.2e}")
+    for name, t in med.items():
+        ratio = (
+            "" if name.startswith("grid") else f"{med['grid kernel (microg), 1 thread'] / t:9.2f}x"
+        )
+        err = float(np.max(np.abs(outs[name] - ref) / ref))
+        print(f"{name:40s} {t:8.3f} {ratio:>10s} {err:12.1e}")
+    cands = [n for n in med if not n.startswith("grid") and n != "batched linalg.solve"]
+    best = min(cands, key=lambda n: med[n])
+    print(
+        f"ratio grid kernel / strongest baseline ({best}): "
+        f"{med['grid kernel (microg), 1 thread'] / med[best]:.2f}; grid kernel on {cpus} threads "
+        f"{t_grid_wall:.3f} s wall (indicative: shared cores); max difference from the "
+        f"batched solve {float(np.max(np.abs(mine - ref) / ref)):.1e}"
+    )
 
     model = IsolatorModel.from_dimensionless(450.0, 135.0, k=10.0, mu=0.05, zeta=0.2)
     A, B, C = state_space(model)
@@ -154,7 +217,10 @@ def main() -> None:
     t_non = np.cumsum(np.r_[0.0, rng.choice([5e-4, 1e-3, 2e-3], 999_999)])
     t_inc = np.cumsum(np.r_[0.0, rng.choice([5e-4, 7.3e-4, 1.1e-3], 999_999)])
     t_pw = np.r_[0.0, np.cumsum(np.r_[np.full(500_000, 1e-3), np.full(499_999, 1.37e-3)])]
-    print("\nexact FOH package response, 4 states, 10^6 samples (1 BLAS thread)")
+    print(
+        "\nexact FOH package response, 4 states, 10^6 samples (1 BLAS thread, CPU time, "
+        f"median of {ROUNDS} interleaved rounds)"
+    )
     grids = (
         ("uniform", t_uni),
         ("steps 0.5/1/2 ms (commensurate)", t_non),
@@ -163,9 +229,8 @@ def main() -> None:
     )
     for label, t in grids:
         a = np.sin(1.02 * t) + 0.1 * np.sin(17.0 * t)
-        with threadpool_limits(1):
-            t_td, res = best_of(lambda t=t, a=a: package_response(model, t, a), repeat=3)
-        line = f"  {label:33s} microg {t_td * 1e3:7.1f} ms"
+        line = f"  {label:33s}"
+        fns = {"microg": lambda t=t, a=a: package_response(model, t, a)}
         if foh is not None:
             h = np.diff(t)
             span = (t[-1] - t[0]) / h.size
@@ -177,7 +242,14 @@ def main() -> None:
             index = index.astype(np.int64)
             args = (Phi, G1, G2, index, C[0].copy(), a, t)
             foh(Phi, G1, G2, index[:2], C[0].copy(), a[:3], t[:3])  # compile on a short record
-            t_nb, y = best_of(lambda args=args: foh(*args), repeat=3)
+            fns["numba"] = lambda args=args: foh(*args)
+        with threadpool_limits(1):
+            med, outs = interleaved(fns)
+        res = outs["microg"]
+        t_td = med["microg"]
+        line += f" microg {t_td * 1e3:7.1f} ms"
+        if foh is not None:
+            t_nb, y = med["numba"], outs["numba"]
             diff = np.max(np.abs(res.package_accel - y[:, 0])) / np.max(np.abs(y[:, 0]))
             line += f"   numba sequential loop {t_nb * 1e3:7.1f} ms   ratio {t_td / t_nb:5.2f}x"
             line += f"   max difference {diff:.1e} of peak"
@@ -192,7 +264,4 @@ if __name__ == "__main__":
 
         td._DIAGONAL = False
         print("package response: the matrix scans (--scans)")
-    if "--cpu" in sys.argv[1:]:
-        CLOCK = time.thread_time
-        print("timing: this thread's CPU time (--cpu)")
     main()

@@ -17,8 +17,9 @@ Everything is computed with python-control on the closed loop of the generalized
   ``S_a(f) = sum_j |H_aj(f)|^2 S_j``, and its band RMS over a requirement's bands (Gauss-Legendre
   in log f, :data:`NOISE_NODES` nodes per band);
 * **time response**: the station's acceleration at the mount point through the continuous
-  closed loop (:func:`control.forced_response`, exact for input linear between samples): the
-  platform acceleration, the stroke and the actuator force.
+  closed loop (:func:`foh_response`: the first-order hold of :func:`control.forced_response`,
+  exact for input linear between samples, by the blocked scan): the platform acceleration, the
+  stroke and the actuator force.
 """
 
 from __future__ import annotations
@@ -48,6 +49,7 @@ __all__ = [
     "base_and_disturbance",
     "time_response",
     "loops_at_a_time",
+    "foh_response",
     "plant_yu_response",
     "NOISE_NODES",
 ]
@@ -359,8 +361,6 @@ def time_response(
     timepts : (nt,) equally spaced times, s
     base_accel : (3, nt) the mount point's acceleration, m/s^2 (linear between samples)
     """
-    import control as ct
-
     t = np.asarray(timepts, float)
     u = np.asarray(base_accel, float)
     if u.shape != (3, t.size):
@@ -372,6 +372,52 @@ def time_response(
         raise InputError("times must be equally spaced and increasing", where="timepts")
     rows = list(range(3)) + list(range(6, 12)) + list(range(12, 18))
     sub = _select(18, rows) * cl * _inputs(21, range(3))
-    res = ct.forced_response(sub, t, u)
-    y = np.asarray(res.outputs, float).reshape(len(rows), t.size)
+    y = foh_response(sub, t, u)
     return y[:3], y[3:9], y[9:15]
+
+
+def foh_response(system: Any, timepts: np.ndarray, inputs: np.ndarray) -> np.ndarray:
+    """Outputs (q, nt) of a continuous state-space system from rest, input linear between samples.
+
+    The first-order hold of :func:`control.forced_response`, with its discretisation (one
+    matrix exponential of ``[[A dt, B dt, 0], [0, 0, I], [0, 0, 0]]`` gives ``A_d``,
+    ``B_d0``, ``B_d1``, ``x_{k+1} = A_d x_k + B_d0 u_k + B_d1 u_{k+1}``), exact for an input
+    linear between samples; the recurrence is run by the blocked scan
+    :func:`microg._scan.lti_scan` instead of one Python step per sample (equal to the
+    sequential loop to a few roundings per block), ``y = C x + D u``.
+
+    Parameters
+    ----------
+    system : a continuous ``control.StateSpace`` with p inputs and q outputs
+    timepts : (nt,) equally spaced times, s (checked by the caller)
+    inputs : (p, nt) the inputs at the times (their units per the system)
+    """
+    from scipy.linalg import expm
+
+    from microg._scan import lti_scan
+
+    A, B = np.asarray(system.A, float), np.asarray(system.B, float)
+    C, D = np.asarray(system.C, float), np.asarray(system.D, float)
+    t = np.asarray(timepts, float)
+    u = np.asarray(inputs, float).reshape(B.shape[1], t.size)
+    n, p = B.shape
+    if not np.any(u):
+        return np.zeros((C.shape[0], t.size))
+    dt = (t[-1] - t[0]) / (t.size - 1)
+    big = np.zeros((n + 2 * p, n + 2 * p))
+    big[:n, :n] = A * dt
+    big[:n, n : n + p] = B * dt
+    big[n : n + p, n + p :] = np.eye(p)
+    e = expm(big)
+    ad, bd1 = e[:n, :n], e[:n, n + p :]
+    bd0 = e[:n, n : n + p] - bd1
+    if n and np.max(np.abs(np.linalg.eigvals(ad))) >= 1.0:
+        # not asymptotically stable: the sequential recurrence (the scan's composed block maps
+        # would overflow before the states do)
+        x = np.zeros((n, t.size))
+        for k in range(1, t.size):
+            x[:, k] = ad @ x[:, k - 1] + bd0 @ u[:, k - 1] + bd1 @ u[:, k]
+        return C @ x + D @ u
+    steps = np.concatenate([u[:, :-1], u[:, 1:]]).T  # (nt - 1, 2 p): u_k and u_{k+1}
+    y = lti_scan(ad, np.concatenate([bd0.T, bd1.T]), steps, C).T
+    return y + D @ u
