@@ -481,23 +481,32 @@ def _try_lock(fd: int) -> bool:
 class _Lock:
     """The lock file of one run into ``target``, held while the run writes."""
 
-    def __init__(self, target: Path) -> None:
+    def __init__(self, target: Path, holder: list[_Lock]) -> None:
         token = f"{os.getpid()}-{secrets.token_hex(4)}"
         self.stem = f".{target.name}{_TMP_TAG}{token}"
         self.path = target.parent / f"{self.stem}.lock"
-        self.fd = os.open(self.path, os.O_CREAT | os.O_EXCL | os.O_RDWR, 0o600)
+        self.fd = -1
+        self.ours = True  # the name is this run's (random token) unless creating it failed
+        # in the caller's hands before the file exists: a SIGTERM raised at any bytecode from
+        # here on still finds the lock file to remove (an assignment after return would not)
+        holder.append(self)
+        try:
+            self.fd = os.open(self.path, os.O_CREAT | os.O_EXCL | os.O_RDWR, 0o600)
+        except FileExistsError:  # pragma: no cover - another run drew the same token
+            self.ours = False
+            raise
         if not _try_lock(self.fd):  # pragma: no cover - a file only this process created
-            os.close(self.fd)
             raise OSError(errno.EAGAIN, "cannot lock", str(self.path))
 
     def release(self) -> None:
         """Drop the lock and remove its file (again: nothing)."""
-        if self.fd < 0:
-            return
-        os.close(self.fd)
-        self.fd = -1
-        with contextlib.suppress(OSError):
-            self.path.unlink()
+        if self.fd >= 0:
+            os.close(self.fd)
+            self.fd = -1
+        if self.ours:
+            self.ours = False
+            with contextlib.suppress(OSError):
+                self.path.unlink()
 
 
 def _writer_gone(lock: Path) -> bool:
@@ -630,11 +639,13 @@ def write_run_directory(
     tmp: Path | None = None
     previous: Path | None = None
     lock: _Lock | None = None
+    held: list[_Lock] = []
     with _sigterm_as_exception():
         try:
             parent.mkdir(parents=True, exist_ok=True)
             _remove_stale(target)
-            lock = _Lock(target)
+            _Lock(target, held)
+            lock = held[0]
             # the name is held before the directory exists: a SIGTERM between the two (an
             # exception at any bytecode) still finds it to remove (mkdtemp's return would not)
             tmp = parent / lock.stem
@@ -670,8 +681,8 @@ def write_run_directory(
             _cleanup(tmp, previous, target, created, lock)
             raise
         finally:
-            if lock is not None:
-                lock.release()
+            for each in held:
+                each.release()
     return target
 
 
