@@ -235,7 +235,7 @@ def test_rigid_elements_and_constraints(tmp_path):
         + "RBE2,10,1,123456,2,3\n"
         "RBE3,11,,4,123456,1.0,123,5,6,+\n+,2.0,12,2\n"
         "CONM2,1,5,,1.\nCONM2,2,6,,1.\nCONM2,3,1,,1.,,,,,+\n+,1.,,1.,,,1.\n"
-        "SPC1,1,123,1,THRU,3\nSPC,2,6,456\nSPCADD,3,1,2\n"
+        "SPC1,1,123,1,THRU,3\nSPC,2,6,456\nSPCADD,3,1,2\nENDDATA\n"
     )
     g = load_bdf(_deck(tmp_path, text), units="m, N, s")
     assert g.rigid_links[0].dependents == ("grid:2", "grid:3")
@@ -560,3 +560,18 @@ def test_celas2_and_cbush_frequencies_equal_the_hand_solution(tmp_path):
     inv = np.array([1 / 1 + 1 / 3] * 3 + [1 / 1 + 1 / 2] * 3)
     want = np.sqrt(np.arange(1.0, 7.0) * inv)
     np.testing.assert_allclose(np.sort(md.omega[6:]), np.sort(want), rtol=1e-12)
+
+
+def test_a_deck_cut_short_is_refused_not_read_as_a_smaller_model(tmp_path):
+    # the same deck, whole and cut after its first element: the cut one must not read as a
+    # one-element model (NASTRAN's bulk data runs from BEGIN BULK to ENDDATA)
+    head = "SOL 103\nCEND\nBEGIN BULK\n"
+    body = BASE + "GRID,3,,2.,0.,0.\nCBAR,2,10,2,3,0.,1.,0.\n"
+    whole = load_bdf(_deck(tmp_path, head + body + "ENDDATA\n"), units="m, N, s")
+    assert len(whole.beams) == 2
+    cut = head + body[: body.index("GRID,3")]
+    with pytest.raises(InputError, match="no ENDDATA.*cut short") as exc:
+        load_bdf(_deck(tmp_path, cut, "cut.bdf"), units="m, N, s")
+    assert "end it with an ENDDATA line" in str(exc.value)
+    # bulk data alone (an INCLUDEd part, a .blk) needs no ENDDATA
+    assert len(load_bdf(_deck(tmp_path, body, "part.blk"), units="m, N, s").beams) == 2

@@ -304,11 +304,13 @@ def read_cards(
     cur: list[Any] | None = None
     cur_at: tuple[str, int] = ("", 0)
     pattern: list[str] | None = None
+    ended = False
     for ln in lines:
         text = ln.text.split("$", 1)[0] if "$" in ln.text else ln.text
         if not text.strip():
             continue
         if re.match(r"\s*ENDDATA\b", text, re.I):
+            ended = True
             break
         if superelements and re.match(r"\s*BEGIN\s+(BULK|SUPER)", text, re.I):
             if cur is not None:
@@ -361,6 +363,15 @@ def read_cards(
         name, data = _fields_of(text, where)
         cur = [name.strip().upper(), *(_value(f) for f in data)]
         cur_at = (ln.file, ln.number)
+    if begin is not None and not ended and not superelements:
+        # a complete input file's bulk data runs from BEGIN BULK to ENDDATA (QRG, "Bulk
+        # Data Entries"); without it a file cut at a line boundary would read as a
+        # shorter model
+        raise InputError(
+            "the bulk data has no ENDDATA: the file may be cut short",
+            where=shown,
+            fix="if the deck is complete, end it with an ENDDATA line",
+        )
     if cur is not None:
         cards.append(_card(cur, cur_at))
     return cards, case
