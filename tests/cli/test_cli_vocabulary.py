@@ -235,9 +235,9 @@ def test_old_option_names_say_the_new_one(capsys, args: list[str], now: str) -> 
 
 
 def test_model_file_options_are_one_definition_in_every_model_command(capsys, tmp_path):
-    """--subcase and --superelement: the same option (type, range, help) in modes, analyze,
-    locate, from cli/_common.model_file_options; given where they do not apply, the loader's
-    one-line refusal names the option (exit 2)."""
+    """--subcase, --superelement and --coupled-mass: the same option (type, range or
+    choices, help) in modes, analyze, locate, from cli/_common.model_file_options; given
+    where they do not apply, the loader's one-line refusal names the option (exit 2)."""
     from microg.cli._common import MODEL_FILE_FLAGS
 
     shown = {}
@@ -249,9 +249,11 @@ def test_model_file_options_are_one_definition_in_every_model_command(capsys, tm
         for key, flag in MODEL_FILE_FLAGS.items():
             p = opts[key]
             assert p.opts == [flag]
-            shown.setdefault(key, (p.help, p.type.min))
-            assert (p.help, p.type.min) == shown[key]
-    assert shown["subcase"][1] == 1 and shown["superelement"][1] == 0
+            kind = getattr(p.type, "min", None), tuple(getattr(p.type, "choices", ()))
+            shown.setdefault(key, (p.help, kind))
+            assert (p.help, kind) == shown[key]
+    assert shown["subcase"][1][0] == 1 and shown["superelement"][1][0] == 0
+    assert shown["coupled_mass"][1][1] == ("coupled", "coupled-nx9", "consistent")
     data = Path(__file__).resolve().parents[1] / "data" / "nastran" / "cla_residual.op2"
     for cmd in (["analyze", "--out", str(tmp_path / "run")], ["locate"], ["modes"]):
         rc, out, err = _run(capsys, cmd[0], str(data), *cmd[1:], "--units", "in,lbf,s",
@@ -260,3 +262,5 @@ def test_model_file_options_are_one_definition_in_every_model_command(capsys, tm
         assert "--subcase: no modes of subcase 2 in the file (subcases: 1)" in err
         rc, out, err = _run(capsys, cmd[0], "ioc", *cmd[1:], "--superelement", "0")
         assert rc == 2 and "--superelement: applies to OP4 files only" in err, err
+        rc, out, err = _run(capsys, cmd[0], "ioc", *cmd[1:], "--coupled-mass", "coupled")
+        assert rc == 2 and "--coupled-mass: applies to NASTRAN decks" in err, err

@@ -139,15 +139,31 @@ def discretisation_options(command: Callable[..., Any]) -> Callable[..., Any]:
 
 
 #: the options of :func:`model_file_options`, by parameter name (for ``flag_errors``)
-MODEL_FILE_FLAGS = {"subcase": "--subcase", "superelement": "--superelement"}
+MODEL_FILE_FLAGS = {
+    "subcase": "--subcase",
+    "superelement": "--superelement",
+    "coupled_mass": "--coupled-mass",
+}
 
 
 def model_file_options(command: Callable[..., Any]) -> Callable[..., Any]:
-    """``--subcase`` and ``--superelement``: which part of a NASTRAN results file to read.
+    """``--subcase``, ``--superelement`` and ``--coupled-mass``: how a NASTRAN file is read.
 
     The same in every command that reads a model (``modes``, ``analyze``, ``locate``),
-    passed to :func:`microg.load_model` as ``subcase=`` and ``superelement=``.
+    passed to :func:`microg.load_model` as ``subcase=``, ``superelement=`` and
+    ``coupled_mass=``.
     """
+    command = click.option(
+        "--coupled-mass",
+        "coupled_mass",
+        type=click.Choice(["coupled", "coupled-nx9", "consistent"]),
+        default=None,
+        cls=Option,
+        show_default=f"{defaults.NASTRAN_COUPLED_MASS} (Simcenter Nastran 2020.2)",
+        help="A NASTRAN deck with PARAM,COUPMASS > 0: NASTRAN's coupled CBAR mass as "
+        "Simcenter 2020.2 (coupled) or NX 9.1 (coupled-nx9) forms it, or microg's "
+        "consistent mass.",
+    )(command)
     command = click.option(
         "--superelement",
         type=click.IntRange(min=0),

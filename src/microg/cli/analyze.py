@@ -251,6 +251,7 @@ def analyze(
     points_file: Path | None,
     subcase: int | None,
     superelement: int | None,
+    coupled_mass: str | None,
     sources: str | None,
     out_dir: Path,
     as_json: bool,
@@ -304,6 +305,7 @@ def analyze(
             ("points", points_file),
             ("subcase", subcase),
             ("superelement", superelement),
+            ("coupled_mass", coupled_mass),
         )
         if v is not None
     }
@@ -384,6 +386,8 @@ def summary(result: Any, path: Path) -> None:
         if el.any()
         else f"{result.model}: {m.n_rigid} rigid-body modes"
     )
+    if "mass_formulation_note" in result.meta:
+        click.echo(f"  mass: {result.meta['mass_formulation_note']}")
     for name, ob in result.observations.items():
         a = ob.assessment
         verdict = "complies" if a.complies else "DOES NOT COMPLY"

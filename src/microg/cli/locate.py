@@ -319,6 +319,7 @@ def locate(
     points_file: Path | None,
     subcase: int | None,
     superelement: int | None,
+    coupled_mass: str | None,
     as_json: bool,
     out_dir: Path | None,
     static: bool,
@@ -365,6 +366,7 @@ def locate(
             points=points_file,
             subcase=subcase,
             superelement=superelement,
+            coupled_mass=coupled_mass,
         )
     text = dumps(result.to_dict())
     if out_dir is not None:
@@ -394,6 +396,8 @@ def _summary(result: Any) -> None:
         f"{'xyz'[int(np.argmax(np.abs(amap.direction)))]}, {amap.n_samples} samples, "
         f"window {amap.window[0]:g}-{num(amap.window[1])} s"
     )
+    if result.mass_formulation is not None:
+        click.echo(f"mass: {result.mass_formulation}")
     if amap.fundamental is not None:
         click.echo(f"fundamental elastic mode: omega = {num(amap.omega[amap.fundamental])} rad/s")
     for n in amap.nodes:

@@ -35,7 +35,6 @@ FLAGS = {
     "units": "--units",
     "wtmass": "--wtmass",
     "points": "--points",
-    "coupled_mass": "--coupled-mass",
     "constrained": "--constrained",
     **MODEL_FILE_FLAGS,
 }
@@ -104,16 +103,6 @@ def _effective_percent(m: Any) -> dict[str, Any]:
     help="Also write the modes as UFF datasets 15+55 (+164 units) to this file.",
 )
 @model_file_options
-@click.option(
-    "--coupled-mass",
-    "coupled_mass",
-    type=click.Choice(["coupled", "coupled-nx9", "consistent"]),
-    default=None,
-    cls=Option,
-    show_default=f"{defaults.NASTRAN_COUPLED_MASS} (Simcenter Nastran 2020.2)",
-    help="A NASTRAN deck with PARAM,COUPMASS > 0: NASTRAN's coupled CBAR mass as Simcenter "
-    "2020.2 (coupled) or NX 9.1 (coupled-nx9) forms it, or microg's consistent mass.",
-)
 @click.option(
     "--constrained",
     is_flag=True,

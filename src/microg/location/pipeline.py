@@ -84,6 +84,9 @@ class LocateResult:
     n : int or None
         Functions (ritz) or elements (fem) per beam asked for (None: the default).
     warnings : tuple of str
+    mass_formulation : str or None
+        A frame (deck) model's element mass and what chose it (as ``microg analyze``'s
+        provenance ``mass_formulation_note``); None for stations and modal models.
     """
 
     model: str
@@ -92,6 +95,7 @@ class LocateResult:
     best: Location
     n: int | None = None
     warnings: tuple[str, ...] = ()
+    mass_formulation: str | None = None
 
     def to_dict(self) -> dict:
         """The ``microg locate --json`` document."""
@@ -108,6 +112,8 @@ class LocateResult:
         out.update(d)
         samples = out.pop("samples")
         out["best_location"] = self.best.to_dict()
+        if self.mass_formulation is not None:
+            out["mass_formulation"] = self.mass_formulation
         out["warnings"] = list(self.warnings)
         out["samples"] = samples
         return out
@@ -220,7 +226,8 @@ def location_structure(
 def _load(model: Any, **reader: Any) -> Any:
     """A model object as it is, or a path / shipped name read by the one model loader.
 
-    ``reader``: the loader's options (units, wtmass, points, subcase, superelement).
+    ``reader``: the loader's options (units, wtmass, points, subcase, superelement,
+    coupled_mass).
     """
     given = {k: v for k, v in reader.items() if v is not None}
     if not isinstance(model, str | Path):
@@ -293,6 +300,7 @@ def locate(
     points: str | Path | None = None,
     subcase: int | None = None,
     superelement: int | None = None,
+    coupled_mass: str | None = None,
 ) -> LocateResult:
     """Where to put the laboratory: the acceleration map of a crew force and its best point.
 
@@ -351,6 +359,9 @@ def locate(
         The subcase of an OP2 with modes of several.
     superelement : int, optional
         The superelement of an OP4 holding the matrices of several.
+    coupled_mass : {"coupled", "coupled-nx9", "consistent"}, optional
+        A NASTRAN deck with ``PARAM,COUPMASS`` > 0: which coupled CBAR mass
+        (:func:`microg.load_model`'s).
     """
     from microg.dynamics.forces import crew_force
     from microg.dynamics.modes import solve_modes
@@ -362,6 +373,7 @@ def locate(
         points=points,
         subcase=subcase,
         superelement=superelement,
+        coupled_mass=coupled_mass,
     )
     if method not in ("ritz", "fem"):
         raise InputError(f"unknown method {method!r}", where="method", fix="use ritz or fem")
@@ -441,6 +453,14 @@ def _locate_imported(
             f"{what}: there is no beam line to locate the nodes of the fundamental on "
             "(the map over every sample and the quietest one are given)"
         )
+    form = getattr(model, "mass_formulation", None)
+    note = (getattr(model, "meta", None) or {}).get("mass_formulation_note", form)
     return LocateResult(
-        model=str(model.name), force=force, amap=amap, best=best, n=None, warnings=tuple(warnings)
+        model=str(model.name),
+        force=force,
+        amap=amap,
+        best=best,
+        n=None,
+        warnings=tuple(warnings),
+        mass_formulation=note if isinstance(form, str) else None,
     )
