@@ -14,6 +14,7 @@ Fixtures (tests/data/nastran/, from pyyeti's wheel, LICENSE-pyyeti.txt, README.m
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
@@ -89,3 +90,19 @@ def test_against_pynastran_eigenvalues():
         cycles = np.sort(np.abs(next(iter(ref.eigenvalues.values())).cycles))
         mine = np.sort(np.abs(read_op2_modes(path).freq_hz_signed))
         np.testing.assert_allclose(mine, cycles, rtol=1e-6, atol=1e-9)
+
+
+@pytest.mark.parametrize("path, f06", [(CSUPER, F06_CSUPER), (EXTSE, F06_EXTSE)])
+def test_free_free_assemblies_run_from_the_command_line(path, f06, capsys):
+    # the modal structure checks the rigid modes against rigid motion at the grids the
+    # reader fitted: the grids it left out (70, the modal grids) and the DOFs no mode moves
+    # (grid 70 of extseout has no x, ry, rz) keep the file's motion and are not checked
+    from microg.cli import main
+    from microg.structure.modal import modal_structure
+
+    s = modal_structure(modal_model_from_op2(path, IN))
+    assert s.total_mass > 0
+    assert main(["modes", str(path), "--units", "in, lbf, s", "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert [m["rigid"] for m in doc["modes"]].count(True) == 6
+    assert doc["modes"][6]["freq_hz"] == pytest.approx(f06[6], rel=1e-6)  # as above

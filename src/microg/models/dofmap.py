@@ -112,7 +112,7 @@ def dof_map_from_op2(path: str | Path, superelement: int | None = None) -> DofMa
             raise InputError(
                 f"the file holds the DOFs of superelements {', '.join(map(str, ses))}",
                 where=label,
-                fix="choose one with --superelement N (superelement=N)",
+                fix="choose one with superelement=N",
             )
         t = tabs[0]
     elif superelement in ses:

@@ -9,8 +9,11 @@ Dispatch by suffix:
 * ``.unv`` / ``.uff``: UFF 15/2411 + 55 (+164) (:func:`microg.models.uff.modal_model_from_uff`);
 * ``.npz``: microg's own modal-model file (:func:`microg.models.modal.load_modal_model`);
 * ``.toml`` or a shipped name: a station (:func:`microg.models.toml.load_station`);
-* ``.bdf`` / ``.dat``: a NASTRAN deck, solved by microg's frame FE
-  (:func:`microg.models.bdf.load_bdf`).
+* ``.bdf`` / ``.dat`` / ``.blk`` / ``.nas`` / ``.bulk``: a NASTRAN deck (or bulk data), solved by
+  microg's FE (:func:`microg.models.bdf.load_bdf`).
+
+A ``.pch`` punch file or an ``.f06`` listing is NASTRAN output that is not a model: it is refused,
+naming the file to give instead.
 
 NASTRAN files declare no units: ``units`` (``"in, lbf, s"``) is required for them, from the
 argument or the points file; a missing declaration is an error, never a guess.
@@ -27,9 +30,15 @@ from microg.errors import InputError
 if TYPE_CHECKING:
     from microg.models.modal import ModelOptions
 
-__all__ = ["load_model", "loads_station", "MODEL_SUFFIXES"]
+__all__ = ["load_model", "loads_station", "MODEL_SUFFIXES", "DECK_SUFFIXES"]
 
-MODEL_SUFFIXES = (".op2", ".op4", ".unv", ".uff", ".npz", ".toml", ".bdf", ".dat")
+DECK_SUFFIXES = (".bdf", ".dat", ".blk", ".nas", ".bulk")
+# NASTRAN output that is not a model, with what to give instead
+_NOT_A_MODEL = {
+    ".pch": "a punch file holds a run's output tables, not a model",
+    ".f06": "an F06 is NASTRAN's printed listing, not a model",
+}
+MODEL_SUFFIXES = (".op2", ".op4", ".unv", ".uff", ".npz", ".toml", *DECK_SUFFIXES, *_NOT_A_MODEL)
 
 
 def _units(
@@ -115,9 +124,17 @@ def load_model(
     label = str(path)
     if subcase is not None and suffix != ".op2":
         raise InputError("applies to OP2 files only", where="subcase", fix="leave it out")
-    if coupled_mass is not None and suffix not in (".bdf", ".dat"):
+    if suffix in _NOT_A_MODEL:
         raise InputError(
-            "applies to NASTRAN decks (.bdf, .dat) only", where="coupled_mass", fix="leave it out"
+            _NOT_A_MODEL[suffix],
+            where=label,
+            fix="give the run's .op2 (SOL 103 modes), its .op4 (MAA/KAA) or its deck (.bdf, .dat)",
+        )
+    if coupled_mass is not None and suffix not in DECK_SUFFIXES:
+        raise InputError(
+            "applies to NASTRAN decks (.bdf, .dat, .blk, .nas, .bulk) only",
+            where="coupled_mass",
+            fix="leave it out",
         )
     if subcase is not None and (
         isinstance(subcase, bool) or not isinstance(subcase, int) or subcase < 1
@@ -152,7 +169,7 @@ def load_model(
 
         _only_for_foreign_files(units, wtmass, "a station or graph model")
         return load_station(p)
-    if suffix in (".bdf", ".dat"):
+    if suffix in DECK_SUFFIXES:
         from microg.models.bdf import load_bdf
 
         u = _units(units, wtmass, opts, label, need=True)

@@ -421,7 +421,7 @@ def _op4_scope(op4m: Op4Model, superelement: int | None) -> tuple[Op4Model, str]
         raise InputError(
             f"the file holds the matrices of superelements {', '.join(map(str, ses))}",
             where=op4m.path,
-            fix="choose one with --superelement N (superelement=N)",
+            fix="choose one with superelement=N",
         )
     if superelement not in ses:
         raise InputError(

@@ -614,7 +614,7 @@ def read_op2_modes(path: str | Path, *, subcase: int | None = None) -> Op2Modes:
             raise InputError(
                 f"the file holds modes of subcases {', '.join(str(v) for v in subs)}",
                 where=f.path,
-                fix="choose one with --subcase N (subcase=N)",
+                fix="choose one with subcase=N",
             )
         subcase = subs[0]
     elif subcase not in subs:

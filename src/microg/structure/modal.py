@@ -271,21 +271,36 @@ def rigid_coefficients(model: ModalModel) -> np.ndarray:
 
     ``A`` is the least-squares fit at up to :data:`RIGID_FIT_GRIDS` grids (one grid
     already determines it: ``R0`` of a grid is invertible); the fit is verified at every
-    grid.  Raises ModelError when the rigid modes are not rigid-body motions of the grids.
+    grid that moves rigidly: the grids the reader left out of its rigid-body fit
+    (``replaced_rigid.excluded_grids``: partly connected grids, modal DOFs), where the
+    file's motion is kept, are left out here too, and so are DOFs zero in every mode (not
+    in the file).  Raises ModelError when the rigid modes are not rigid-body motions of
+    the other grids.
     """
     idx = np.flatnonzero(model.rigid)
     if idx.size == 0:
         return np.zeros((6, 0))
-    sub = _fit_grids(model.xyz_m)
-    r_sub = rigid_basis_at(model.xyz_m[sub]).reshape(-1, 6)
-    a, *_ = np.linalg.lstsq(r_sub, model.phi[sub][:, :, idx].reshape(-1, idx.size), rcond=None)
-    pr = model.phi[:, :, idx]  # (g, 6, k)
+    excluded = () if model.replaced_rigid is None else model.replaced_rigid.excluded_grids
+    keep = ~np.isin(model.grid_ids, np.asarray(excluded, dtype=np.int64))
+    if not keep.any():
+        keep[:] = True
+    xyz, phi = model.xyz_m[keep], model.phi[keep]
+    # DOFs zero in every mode are not in the file (a partly output grid): not fitted
+    act = np.any(phi != 0.0, axis=2)  # (g, 6)
+    if not act.any():
+        act[:] = True
+    sub = _fit_grids(xyz)
+    r_sub = rigid_basis_at(xyz[sub])[act[sub]]
+    a, *_ = np.linalg.lstsq(r_sub, phi[sub][:, :, idx][act[sub]], rcond=None)
+    pr = phi[:, :, idx]  # (g, 6, k)
     # R0 a at every grid: translation a_t + a_r x x_g, rotation a_r
-    x = model.xyz_m[:, :, None]
+    x = xyz[:, :, None]
     ar = a[3:][None, :, :]
     pred_t = a[:3][None] + np.cross(ar, x, axisa=1, axisb=1, axisc=1)
-    err2 = np.sum((pr[:, :3] - pred_t) ** 2) + np.sum((pr[:, 3:] - ar) ** 2)
-    err = np.sqrt(err2) / max(float(np.linalg.norm(pr)), 1e-300)
+    pred = np.concatenate([pred_t, np.broadcast_to(ar, pred_t.shape)], axis=1)
+    err = np.sqrt(np.sum(((pr - pred) * act[:, :, None]) ** 2)) / max(
+        float(np.linalg.norm(pr)), 1e-300
+    )
     if err > 1e-8:
         raise ModelError(
             f"the modes marked rigid are not rigid-body motions of the grids (residual {err:.2g})",
