@@ -83,3 +83,27 @@ def test_outboard_with_spoints_rbe2_rbe3_mpc_matches_nx_fixed_interface_modes():
     # the run is NX Nastran 9.1 (outboard.out's header) with COUPMASS 1: its coupled CBAR
     # mass ("coupled-nx9"); measured 2.3e-7, the F06 prints 7 digits (rounding 5e-7): 1e-6
     np.testing.assert_allclose(f, nx_hz, rtol=1e-6)
+
+
+@pytest.mark.parametrize("stem", ["make_gm_nx9_rbe3_um_5", "make_gm_nx9_rbe3_um_6"])
+def test_um_decks_solve_as_the_same_deck_without_um(stem, tmp_path):
+    # UM only moves the RBE3's dependency from its reference grid (124, which nothing else
+    # reaches and which has no mass) onto independent grids: the constraint equations, hence
+    # the modes, are those of the same deck with the UM entry removed.  These two decks were
+    # refused as a "massless mechanism" because the components UM frees at grid 124 keep
+    # ~1e-20 of round-off stiffness and ~1e-35 of mass from the RBE3 coefficients
+    text = (DATA / "gm" / f"{stem}.dat").read_text()
+    um = [ln for ln in text.splitlines() if ln.split()[:1] == ["UM"]]
+    assert len(um) == 1  # the RBE3's one UM continuation
+    plain = tmp_path / "plain.dat"
+    plain.write_text("\n".join(ln for ln in text.splitlines() if ln not in um) + "\n")
+    with_um = solve_modes(build_frame(load_bdf(DATA / "gm" / f"{stem}.dat", units="m, N, s")), 20)
+    without = solve_modes(build_frame(load_bdf(plain, units="m, N, s")), 20)
+    assert with_um.n_rigid == without.n_rigid == 6
+    assert np.all(with_um.omega[:6] == 0.0)
+    # two parametrisations of one constrained system, each condensed and solved densely: the
+    # stiffness spans ~1e12 (rotations of 4-mm bars against the lowest modal stiffness), so
+    # round-off may move an eigenvalue by up to eps * 1e12 ~ 2e-4; measured 3.6e-8 on a
+    # frequency, and 1e-6 is 28x that, while a wrong UM solve or a dropped coupling of the
+    # coordinate change moves these modes by more than 1e-3
+    np.testing.assert_allclose(with_um.omega[6:], without.omega[6:], rtol=1e-6)

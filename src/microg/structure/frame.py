@@ -395,7 +395,13 @@ def build_frame(
     k_abs = np.asarray(abs(Kn).sum(axis=1)).ravel()
     m_abs = np.asarray(abs(Mn).sum(axis=1)).ravel()
     k_scale = float(np.max(Kn.diagonal())) if Kn.nnz else 0.0
-    unconnected = keep & (k_abs <= 1e-14 * max(k_scale, 1e-300)) & (m_abs == 0)
+    m_scale = float(np.max(Mn.diagonal())) if Mn.nnz else 0.0
+    # round-off, not a connection: a rigid element's coefficients of order eps leave ~1e-20
+    # of stiffness and ~1e-35 of mass on a component nothing else reaches (an RBE3 whose UM
+    # frees its reference grid's components), which must not pose as a massless mechanism
+    unconnected = (
+        keep & (k_abs <= 1e-14 * max(k_scale, 1e-300)) & (m_abs <= 1e-14 * max(m_scale, 1e-300))
+    )
     keep &= ~unconnected
     live = np.flatnonzero(keep)
     names = fm.names
