@@ -282,6 +282,17 @@ def test_fixture_deck_cards_and_ignored_ones():
     assert any("K6ROT" in w for w in g.meta["warnings"])
 
 
+def test_analysis_sets_are_said_to_be_unapplied(tmp_path):
+    # a NASTRAN run with BSET/QSET prints fixed-boundary modes: the free-free modes microg
+    # solves are not that table, and the deck's sets are named in one warning
+    plain = load_bdf(_deck(tmp_path, BASE), units="m, N, s")
+    assert not any("analysis sets" in w for w in plain.meta["warnings"])
+    g = load_bdf(_deck(tmp_path, BASE + "BSET1,123456,1\nQSET1,0,2\n", "s.bdf"), units="m, N, s")
+    said = [w for w in g.meta["warnings"] if w.startswith("analysis sets")]
+    assert len(said) == 1 and "(BSET1, QSET1) are not applied" in said[0]
+    assert "fixed-boundary" in said[0]
+
+
 # --------------------------------------------------------------------------- bad input
 
 

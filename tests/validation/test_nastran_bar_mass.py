@@ -193,3 +193,31 @@ def test_ogpwg_truth_read_by_pynastran_too():
     mo = ref.grid_point_weight["SUPERELEMENT 0"].MO
     # the same float32 words widened to float64: equal to the bit (measured)
     np.testing.assert_array_equal(read_op2_modes(DATA / "cla_residual.op2").rigid_mass, mo)
+
+
+def test_inboard_component_of_the_nx9_run():
+    # nas2cam_extseout/inboard.dat (NX Nastran 9.1, its inboard.out's header): SOL 103 of the
+    # bulk data cla_inboard.blk (the same file) with BSET1,123456,3,11,19,27 and a q-set, an
+    # external superelement's run: its eigenvalues (extseout_inboard.op2, no LAMA: the OUGV1
+    # record headers, read by pyNastran 1.4.1 as 6.129345508646885, 6.130134198333572 and
+    # 23.631877671556406 Hz) are the fixed-interface modes, the b-set grids clamped
+    import dataclasses
+
+    from microg.models.graph_model import Constraint
+    from microg.structure.frame import build_frame
+
+    truth = np.array([6.129345508646885, 6.130134198333572, 23.631877671556406])
+    op2 = read_op2_modes(DATA / "extseout_inboard.op2")
+    # microg reads the same words (float32 eigenvalues widened): to 1e-15 of pyNastran's
+    np.testing.assert_allclose(op2.freq_hz_signed, truth, rtol=1e-15)
+    bset = tuple(Constraint(f"grid:{i}", "123456") for i in (3, 11, 19, 27))
+    f = {}
+    for form in ("coupled-nx9", "coupled"):
+        g = load_bdf(DATA / "cla_inboard.blk", units=UNITS, coupled_mass=form)
+        md = solve_modes(build_frame(dataclasses.replace(g, constraints=bset), constrained=True), 3)
+        f[form] = md.freq_hz
+    # the OUGV1 header's eigenvalue is float32 (6e-8 relative, 3e-8 on a frequency): measured
+    # 2.6e-8 at the worst mode, 2e-7 is 7x the word's precision
+    np.testing.assert_allclose(f["coupled-nx9"], truth, rtol=2e-7)
+    # Simcenter's form is 1.8% off this NX 9.1 run at the third mode: the test tells them apart
+    assert np.max(np.abs(f["coupled"] / truth - 1.0)) > 0.01

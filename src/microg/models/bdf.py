@@ -93,6 +93,7 @@ from microg.models.graph_model import (
 from microg.models.modal import ModalPoint
 
 __all__ = [
+    "ANALYSIS_SET_CARDS",
     "IGNORED_CARDS",
     "MAX_CARDS",
     "MAX_INCLUDE_DEPTH",
@@ -135,6 +136,12 @@ IGNORED_CARDS = (
     "DVGRID",
 )
 # fmt: on
+
+#: the ignored cards that define NASTRAN's analysis sets (a reduction or a fixed boundary): a
+#: run that uses them prints other eigenvalues than the structure's, so their presence is said
+ANALYSIS_SET_CARDS = frozenset(
+    ("ASET", "ASET1", "OMIT", "OMIT1", "QSET", "QSET1", "BSET", "BSET1", "CSET", "CSET1")
+)
 
 
 # --------------------------------------------------------------------------- deck -> graph
@@ -232,6 +239,14 @@ class _Deck:
             self.warnings.append(
                 "cards ignored (no stiffness or mass): "
                 + ", ".join(f"{k} ({v})" for k, v in sorted(ignored.items()))
+            )
+        sets = sorted(k for k in ignored if k in ANALYSIS_SET_CARDS)
+        if sets:
+            self.warnings.append(
+                f"analysis sets ({', '.join(sets)}) are not applied: these are the modes of the "
+                "whole structure (free-free, or with its SPC under constrained=True); a NASTRAN "
+                "run that reduces to these sets (ASET/OMIT, Craig-Bampton BSET/QSET, EXTSEOUT) "
+                "prints the modes of its reduced or fixed-boundary model instead"
             )
         params = self.params()
         wt = self.wtmass(params)
