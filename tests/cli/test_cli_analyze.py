@@ -190,7 +190,9 @@ def test_console_gives_one_verdict_line_per_criterion(tmp_path: Path, capsys) ->
     assert rc == 0, err
     lines = out.splitlines()
     head = next(line for line in lines if line.startswith("  lab: "))
-    assert head.startswith("  lab: DOES NOT COMPLY with iss")
+    # no judged criterion fails and one is undecided: the headline says so, neither a pass
+    # nor a fail (the JSON's verdict is the same word, its complies False: not shown to comply)
+    assert head.startswith("  lab: UNDECIDED with iss (no judged criterion below fails")
     assert "ABOVE" not in out and "complies without isolation" not in out
     crit = [line.strip() for line in lines if line.startswith("    ") and "isolation" not in line]
     names = [c.split(":")[0] for c in crit]
@@ -201,6 +203,13 @@ def test_console_gives_one_verdict_line_per_criterion(tmp_path: Path, capsys) ->
     assert by["iss unresolved bands"].startswith("iss unresolved bands: undecided: ")
     assert "reported only: FAILS" in by["integrated-10ug-s-per-axis-10s"]
     assert "reported only: FAILS" in by["report peak 1e-5 g"]
+    # a reported-only line names where its limit comes from
+    for c in d["criteria"]:
+        if c["status"] == "reported":
+            assert by[c["name"]].endswith(f"(limit from {c['source']})")
+    assert d["verdict"] == "undecided" and d["complies"] is False
+    full = json.loads((tmp_path / "o" / "results.json").read_text())
+    assert full["verdict"] == "undecided" and full["complies"] is False
     iso = next(line for line in lines if line.startswith("    isolation: "))
     assert iso.startswith("    isolation: undecided: ") and "peak limit" not in iso
     assert d["isolation"]["status"] == "undecided" and d["peak_limit_g"] is None

@@ -347,3 +347,35 @@ def test_bad_predicted(tmp_path: Path, csv_file: Path, prediction: Path, capsys)
     )
     assert rc == 0 and json.loads(out)["prediction"]["sensor"]["point"] == "crew"
     _bad(tmp_path, capsys, [str(csv_file), "--observe", "lab"], "--observe")
+
+
+@pytest.mark.parametrize("fast_tone_ug", [0.0, 500.0])
+def test_undecided_is_neither_a_pass_nor_a_fail(tmp_path: Path, capsys, fast_tone_ug) -> None:
+    # a 20-s record at 50 Hz: 50 micro-g RMS at 0.2 Hz, in a band the record cannot resolve
+    # (undecided), and nothing else that a judged band sees: the verdict is "undecided" on the
+    # console, in the JSON and on the page.  A 500 micro-g tone at 5 Hz (a resolved band whose
+    # ISS limit is 5 x 18 = 90 micro-g) makes a judged band fail: then it is a fail, whatever
+    # the undecided band would say
+    fs, n = 50.0, 1000
+    t = np.arange(n) / fs
+    x = 50e-6 * np.sqrt(2) * np.sin(2 * np.pi * 0.2 * t)
+    x = x + fast_tone_ug * 1e-6 * np.sqrt(2) * np.sin(2 * np.pi * 5.0 * t)
+    path = tmp_path / "short.csv"
+    body = "\n".join(f"{ti:.10g},{v:.17g},0,0" for ti, v in zip(t, x, strict=True))
+    path.write_text("time [s], x [g], y [g], z [g]\n" + body + "\n")
+    out_dir = tmp_path / "o"
+    rc, out, err = _run(capsys, ["assess", str(path), "--out", str(out_dir)])
+    assert rc == 0, err
+    d = json.loads((out_dir / "results.json").read_text())
+    o = next(iter(d["observations"].values()))
+    kinds = {c["status"] for c in o["criteria"]}
+    assert "undecided" in kinds
+    judged_fail = any(c["status"] == "judged" and not c["complies"] for c in o["criteria"])
+    assert judged_fail == (fast_tone_ug > 0)
+    want = "fails" if judged_fail else "undecided"
+    assert o["verdict"] == d["verdict"] == want and d["complies"] is False
+    head = next(line for line in out.splitlines() if line.startswith("  verdict vs "))
+    assert head.startswith(f"  verdict vs iss: {'DOES NOT COMPLY' if judged_fail else 'UNDECIDED'}")
+    page = next(out_dir.glob("*.html")).read_text()
+    said = "Verdict: does NOT comply" if judged_fail else "Verdict: undecided: no judged criterion"
+    assert said in page and ("does NOT comply" in page) == judged_fail

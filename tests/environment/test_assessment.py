@@ -358,7 +358,7 @@ def test_to_dict_units_inf_and_json():
     plain = {
         "third_octave", "requirement", "requirement_source", "complies", "worst_band", "record",
         "integrated_accel_sliding", "integrated_accel_pims", "transient", "warnings",
-        "criteria",
+        "criteria", "verdict",
     }  # fmt: skip
     for k in d:
         assert k in plain or k.endswith(units), k

@@ -270,8 +270,6 @@ def _modules() -> dict[str, tuple[Path, bool]]:
     return out
 
 
-
-
 @pytest.mark.parametrize("module", sorted(PUBLIC_NAMES))
 def test_public_names_still_import_from_their_module(module):
     mod = importlib.import_module(module)

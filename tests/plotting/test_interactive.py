@@ -78,5 +78,6 @@ def test_notebook_tables_follow_the_results(modes):
         assert f"<td>{o.peak_accel_g:.3g}</td>" in row
         # the verdict word follows the verdict field
         assert ("<td>complies</td>" in row) == o.complies
+        assert ("<td>fails</td>" in row) == (o.verdict == "fails")
     fig = r.plot3d()
     assert {t.name for t in fig.data} >= {"model (undeformed)", "mode shape", "force direction"}

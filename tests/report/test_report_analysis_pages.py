@@ -51,6 +51,23 @@ def test_each_point_lists_its_verdict_per_criterion() -> None:
     assert "undecided" in section and "reported only" in section
     status = r.observations["lab"].isolation.status
     assert f"<b>Isolation</b> ({status}):" in page
+    # each row's result is the one wording of every page (criterion_verdict) and its source
+    from html import escape
+
+    from microg.report.environment import criterion_verdict
+
+    cells = re.findall(r"<tr><td class=\"l\">.*?</tr>", section, re.S)
+    for c, row in zip(crit, cells, strict=True):
+        text, css = criterion_verdict(c)
+        assert f'<td class="l {css}">{escape(text)}</td>' in row, row
+        assert row.endswith(f'<td class="l">{escape(c["source"])}</td></tr>'), row
+    # the point's and the page's verdict: undecided (no judged fail), never "do NOT comply"
+    assert r.observations["lab"].verdict == r.verdict == "undecided"
+    assert "do NOT comply" not in page and "does not comply" not in page
+    assert "undecided: no observed point fails a judged criterion" in page
+    # the notebook's table says the same word
+    nb = r._repr_html_()
+    assert "<td>undecided (the record cannot decide a criterion)</td>" in nb
 
 
 def test_the_fitted_mass_note_lists_as_many_items_as_it_counts(sources_page: str) -> None:

@@ -18,7 +18,7 @@ from microg.analysis.options import REPORT_LIMIT_G, AnalysisOptions, Disturbance
 from microg.dynamics.modes import Modes
 from microg.dynamics.peaks import PeakResponse
 from microg.dynamics.response import PointResponse
-from microg.environment.criteria import CriterionVerdict
+from microg.environment.criteria import CriterionVerdict, combine_verdicts
 from microg.environment.metrics import Assessment
 from microg.environment.requirements import Requirement
 from microg.isolation.advise import IsolationAdvice
@@ -97,6 +97,11 @@ class Observation:
     def complies(self) -> bool:
         """The band verdict at this point."""
         return bool(self.assessment.complies)
+
+    @property
+    def verdict(self) -> str:
+        """``complies``, ``fails`` or ``undecided`` at this point (the assessment's)."""
+        return self.assessment.verdict
 
     def to_dict(self) -> dict[str, Any]:
         """The observation block of ``microg analyze --json``."""
@@ -243,6 +248,19 @@ class Analysis:
         return ok
 
     @property
+    def verdict(self) -> str:
+        """``complies``, ``fails`` or ``undecided`` over every point (a fail anywhere fails).
+
+        A frequency-domain band table judges every band, so its points comply or fail.
+        """
+        got = [o.verdict for o in self.observations.values()]
+        if self.frequency_domain is not None:
+            got += [
+                "complies" if c else "fails" for c in np.asarray(self.frequency_domain.complies)
+            ]
+        return combine_verdicts(got)
+
+    @property
     def responses(self) -> dict[str, PointResponse]:
         """Response of each observed point."""
         return {n: o.response for n, o in self.observations.items()}
@@ -282,6 +300,7 @@ class Analysis:
             "observations": {n: ob.to_dict() for n, ob in self.observations.items()},
             **self._frequency_dict(),
             "complies": self.complies,
+            "verdict": self.verdict,
             "report_criterion": {
                 "limit_g": REPORT_LIMIT_G,
                 "peak_within": all(
@@ -368,7 +387,7 @@ class Analysis:
         return modes_3d(self.modes, force_points=forces, observed=list(self.observations))
 
     def _repr_html_(self) -> str:
-        """The verdict table in a notebook: each point's peak, band verdict and margin."""
+        """The verdict table in a notebook: each point's peak, smallest band margin and verdict."""
         from html import escape
 
         rows = []
@@ -376,12 +395,11 @@ class Analysis:
             to = o.assessment.third_octave
             judged = np.asarray(to.margin)[:, np.asarray(to.judged, bool)]
             margin = float(judged.min()) if judged.size else float("nan")
-            if o.complies:
-                status = "complies"
-            elif margin < 1.0:
-                status = "fails"
-            else:  # every judged band passes, yet no pass: bands the record cannot resolve
-                status = "not shown (unresolved bands exceed their limits)"
+            status = {
+                "complies": "complies",
+                "fails": "fails",
+                "undecided": "undecided (the record cannot decide a criterion)",
+            }[o.verdict]
             rows.append(
                 f"<tr><td>{escape(name)}</td><td>{o.peak_accel_g:.3g}</td>"
                 f"<td>{margin:.3g}</td><td>{status}</td></tr>"
@@ -389,7 +407,7 @@ class Analysis:
         return (
             f"<p><b>{escape(str(self.model))}</b> against {escape(self.requirement.name)}</p>"
             "<table><tr><th>point</th><th>peak (g)</th><th>smallest band margin</th>"
-            f"<th>band verdict</th></tr>{''.join(rows)}</table>"
+            f"<th>verdict</th></tr>{''.join(rows)}</table>"
         )
 
 

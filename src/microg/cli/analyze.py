@@ -374,9 +374,18 @@ def write_outputs(result: Any, out_dir: Path, *, static: bool = False) -> tuple[
     return write_output_files(out_dir, files, where="--out"), text
 
 
+#: what each headline verdict rests on (the criteria lines printed under it)
+_BASIS = {
+    "complies": "every judged criterion below complies",
+    "fails": "a judged criterion below fails",
+    "undecided": "no judged criterion below fails, but the record cannot decide one: not a pass",
+}
+
+
 def summary(result: Any, path: Path) -> None:
     """The console summary: modes, each point's verdict per criterion, isolation, warnings."""
     from microg.analysis.result import report_criterion
+    from microg.environment.criteria import HEADLINE
 
     m = result.modes
     el = (m.omega > 0) & result.used
@@ -390,9 +399,8 @@ def summary(result: Any, path: Path) -> None:
         click.echo(f"  mass: {result.meta['mass_formulation_note']}")
     for name, ob in result.observations.items():
         a = ob.assessment
-        verdict = "complies" if a.complies else "DOES NOT COMPLY"
         click.echo(
-            f"  {name}: {verdict} with {a.requirement} (the judged criteria below; peak "
+            f"  {name}: {HEADLINE[a.verdict]} with {a.requirement} ({_BASIS[a.verdict]}; peak "
             f"{a.peak_accel_g:.3g} g, RMS {a.rms_accel_g:.3g} g)"
         )
         for c in (*a.criteria, report_criterion(a)):

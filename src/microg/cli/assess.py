@@ -216,9 +216,12 @@ def merge_assessments(results: list[dict[str, Any]]) -> dict[str, Any]:
     """One ``--json`` document for the sensors of one file (each a :func:`run_assessment`).
 
     ``observations`` and ``intervals`` are keyed by sensor; ``complies`` holds for all of
-    them; ``warnings`` carry the sensor's name when the file has several.  With one sensor
-    the document is that sensor's own.
+    them, and ``verdict`` is theirs combined (a fail anywhere fails); ``warnings`` carry the
+    sensor's name when the file has several.  With one sensor the document is that sensor's
+    own.
     """
+    from microg.environment.criteria import combine_verdicts
+
     if len(results) == 1:
         return results[0]["json"]
     docs = [r["json"] for r in results]
@@ -247,6 +250,7 @@ def merge_assessments(results: list[dict[str, Any]]) -> dict[str, Any]:
             else {}
         ),
         "complies": all(bool(d["complies"]) for d in docs),
+        "verdict": combine_verdicts(d["verdict"] for d in docs),
         "warnings": [f"{k}: {w}" for k, d in zip(keys, docs, strict=True) for w in d["warnings"]],
     }
 
@@ -325,6 +329,7 @@ def run_assessment(
         "observations": {key: a.to_dict()},
         "intervals": {key: iv.to_dict()},
         "complies": bool(a.complies),
+        "verdict": a.verdict,
         "warnings": warnings,
     }
     return {"record": record, "key": key, "assessment": a, "intervals": iv, "json": doc}
@@ -395,6 +400,7 @@ def _charts(result: dict[str, Any]) -> dict[str, list[Any]]:
 
 
 def _summary(result: dict[str, Any]) -> None:
+    from microg.environment.criteria import HEADLINE
     from microg.units import G0
 
     rec, a, iv, key = result["record"], result["assessment"], result["intervals"], result["key"]
@@ -406,7 +412,6 @@ def _summary(result: dict[str, Any]) -> None:
     )
     mean = ", ".join(f"{n} {num(v * ug)}" for n, v in zip(a.axes, a.mean_accel_g_axis, strict=True))
     click.echo(f"  mean (quasi-steady or sensor bias, removed before the bands): {mean} micro-g")
-    verdict = "complies" if a.complies else "DOES NOT COMPLY"
     vr = a.verdict_range_hz
     cover = (
         f"bands {num(vr[0])}-{num(vr[1])} Hz judged ({int(a.third_octave.judged.sum())} of "
@@ -414,7 +419,9 @@ def _summary(result: dict[str, Any]) -> None:
         if vr
         else "no band judged"
     )
-    click.echo(f"  1/3-octave vs {a.requirement}: {verdict}; {cover}")
+    click.echo(
+        f"  verdict vs {a.requirement}: {HEADLINE[a.verdict]} (from the criteria below); {cover}"
+    )
     wb = a.worst_band
     if wb is not None:
         click.echo(

@@ -20,7 +20,7 @@ import numpy as np
 from microg._json import json_numbers
 from microg.environment._samples import as_axes, check_finite
 from microg.environment.bands import MIN_BINS, MIN_TIME_BANDWIDTH, band_rms
-from microg.environment.criteria import CriterionVerdict, criterion_verdicts
+from microg.environment.criteria import CriterionVerdict, criterion_verdicts, overall_verdict
 from microg.environment.integrated import (
     IntegratedAcceleration,
     IntegratedBlocks,
@@ -132,6 +132,16 @@ class Assessment:
         """
         return criterion_verdicts(self)
 
+    @property
+    def verdict(self) -> str:
+        """``complies``, ``fails`` or ``undecided``, from :attr:`criteria`.
+
+        ``complies`` exactly when :attr:`complies`; ``undecided`` when no judged criterion
+        fails but the record cannot decide one
+        (:func:`~microg.environment.criteria.overall_verdict`).
+        """
+        return overall_verdict(self.criteria)
+
     # ---------------------------------------------------------------------------- outputs
 
     def to_dict(self) -> dict[str, Any]:
@@ -167,6 +177,7 @@ class Assessment:
             "requirement": self.requirement,
             "requirement_source": self.requirement_source,
             "complies": bool(self.complies),
+            "verdict": self.verdict,
             "peak_limit_g": self.peak_limit_g,
             "worst_band": None if self.worst_band is None else self.worst_band.to_dict(),
             "integrated_accel_sliding": {
@@ -404,11 +415,17 @@ def assess(
             f"{br.reasons[i]})"
             for i in np.nonzero(over)[0]
         )
+        one = int(over.sum()) == 1
         warnings.append(
-            f"{int(over.sum())} bands are not resolved and have a band RMS estimate above their "
-            f"limit, so compliance cannot be shown and the verdict is not a pass: {listed}; "
-            "lengthen "
-            "the record (or sample faster, for bands at Nyquist) to judge them"
+            (
+                "1 band is not resolved and has a band RMS estimate above its limit"
+                if one
+                else f"{int(over.sum())} bands are not resolved and have a band RMS estimate "
+                "above their limits"
+            )
+            + f", so compliance cannot be shown and the verdict is undecided: {listed}; "
+            f"lengthen the record (or sample faster, for bands at Nyquist) to judge "
+            f"{'it' if one else 'them'}"
         )
     if np.any(over):
         complies = False

@@ -13,7 +13,10 @@ Each criterion an :class:`~microg.environment.assessment.Assessment` looks at ge
   criterion makes ``complies`` false: compliance is not shown.
 
 ``complies`` of the assessment is exactly: every judged criterion complies and none is
-undecided (:func:`verdict_complies`).
+undecided (:func:`verdict_complies`).  The verdict said to the user is three-way
+(:func:`overall_verdict`): ``fails`` when a judged criterion fails (whatever the undecided
+ones would say), ``undecided`` when none fails but one is undecided (compliance is not shown,
+and neither is a failure), ``complies`` otherwise.
 """
 
 from __future__ import annotations
@@ -27,10 +30,25 @@ from microg._json import json_number
 from microg.environment.bands import MIN_BINS, MIN_TIME_BANDWIDTH
 from microg.units import G0
 
-__all__ = ["STATUSES", "CriterionVerdict", "criterion_verdicts", "verdict_complies"]
+__all__ = [
+    "HEADLINE",
+    "STATUSES",
+    "VERDICTS",
+    "CriterionVerdict",
+    "combine_verdicts",
+    "criterion_verdicts",
+    "overall_verdict",
+    "verdict_complies",
+]
 
 #: the kinds of criterion verdict
 STATUSES = ("judged", "reported", "undecided")
+
+#: the verdicts of an assessment (:func:`overall_verdict`)
+VERDICTS = ("complies", "fails", "undecided")
+
+#: each verdict as the console's headline says it
+HEADLINE = {"complies": "complies", "fails": "DOES NOT COMPLY", "undecided": "UNDECIDED"}
 
 
 @dataclass(frozen=True)
@@ -66,10 +84,11 @@ class CriterionVerdict:
             return f"{self.name}: undecided: {self.why}"
         word = "complies" if self.complies else "FAILS"
         head = "" if self.status == "judged" else "reported only: "
-        return (
+        line = (
             f"{self.name}: {head}{word} (margin {self.margin:.3g}; {self.value:.3g} "
             f"{self.unit} against {self.limit:.3g} {self.unit}); {self.why}"
         )
+        return line if self.status == "judged" else f"{line} (limit from {self.source})"
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready criterion; keys carry the unit.
@@ -220,3 +239,30 @@ def verdict_complies(verdicts: tuple[CriterionVerdict, ...]) -> bool:
     return all(v.complies for v in verdicts if v.status == "judged") and not any(
         v.status == "undecided" for v in verdicts
     )
+
+
+def overall_verdict(verdicts: tuple[CriterionVerdict, ...]) -> str:
+    """``fails``, ``undecided`` or ``complies`` (one of :data:`VERDICTS`; module docstring).
+
+    ``complies`` exactly when :func:`verdict_complies`; ``fails`` when a judged criterion
+    fails; ``undecided`` otherwise (no judged failure, an undecided criterion).
+    """
+    if any(v.status == "judged" and not v.complies for v in verdicts):
+        return "fails"
+    if any(v.status == "undecided" for v in verdicts):
+        return "undecided"
+    return "complies"
+
+
+def combine_verdicts(verdicts: Any) -> str:
+    """The verdict of several assessments (points, sensors): a fail, else undecided, else complies.
+
+    Parameters
+    ----------
+    verdicts : iterable of :data:`VERDICTS` entries
+    """
+    got = set(verdicts)
+    bad = got - set(VERDICTS)
+    if bad:
+        raise ValueError(f"not a verdict: {sorted(bad)}")
+    return "fails" if "fails" in got else "undecided" if "undecided" in got else "complies"

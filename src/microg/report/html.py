@@ -31,6 +31,7 @@ if TYPE_CHECKING:  # the seed reproduction loads only for its own report (~0.1 s
     from microg.seed.reproduce import Reproduction
 
 __all__ = [
+    "VERDICT_WORDS",
     "chart_fragment",
     "environment",
     "id_ranges",
@@ -111,6 +112,15 @@ def _bytecode_cache() -> BytecodeCache | None:
         return None
 
 
+#: an assessment's verdict (``complies``/``fails``/``undecided``) as a page says it, with its
+#: CSS class
+VERDICT_WORDS = {
+    "complies": ("complies", "pass"),
+    "fails": ("does NOT comply", "fail"),
+    "undecided": ("undecided: no judged criterion fails, but the record cannot decide one", "warn"),
+}
+
+
 def environment() -> Environment:
     """The Jinja environment over ``microg/report/templates`` (compiled templates cached)."""
     env = Environment(
@@ -120,6 +130,10 @@ def environment() -> Environment:
         bytecode_cache=_bytecode_cache(),
     )
     env.filters["id_ranges"] = id_ranges
+    from microg.report.environment import criterion_verdict  # one definition, for every page
+
+    env.globals["criterion_verdict"] = criterion_verdict
+    env.globals["verdict_words"] = VERDICT_WORDS
     return env
 
 
