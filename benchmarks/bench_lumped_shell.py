@@ -80,9 +80,10 @@ def worker(path: str, solver: str) -> None:
         out["n_rigid"] = md.n_rigid
         out["eff"] = {d: float(np.sum(md.effective_mass[d]) / s.total_mass) for d in "xyz"}
     else:
+        import scipy.sparse as sp
         import scipy.sparse.linalg as spla
 
-        K, M = s.stiffness.tocsc(), s.mass.tocsc()
+        K, M = sp.csc_matrix(s.stiffness), sp.csc_matrix(s.mass)
         dm, dk = M.diagonal(), K.diagonal()
         sigma0 = 1e-3 * float(np.mean(dk[dm > 0] / dm[dm > 0]))
         lam = np.sort(spla.eigsh(K, 30, M, sigma=-sigma0, which="LM")[0])

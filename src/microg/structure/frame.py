@@ -473,10 +473,11 @@ def build_frame(
         # solver's inverse form gives their directions mu = 0
         kept_massless = int(massless.size)
         warnings.append(
-            f"{kept_massless} DOFs carry no mass (lumped mass: bending rotations; NASTRAN's "
-            "coupled CBAR mass: rotations about the bars' axes): condensing them would leave "
-            f"{retained.size} DOFs, a dense matrix beyond the limit of {condense_max}, so they "
-            "are kept as coordinates (singular mass matrix) and solved sparsely"
+            f"{kept_massless} DOFs carry no mass (rotations without rotary inertia: lumped "
+            "mass, shells, NASTRAN's coupled CBAR mass about the bars' axes); condensing them "
+            f"would leave {retained.size} DOFs, a dense matrix beyond the limit of "
+            f"{condense_max}, so they are kept as coordinates (a singular mass matrix) and the "
+            "model is solved sparsely"
         )
         retained = live
         massless = live[:0]
