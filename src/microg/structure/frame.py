@@ -124,7 +124,8 @@ class FrameSamples:
     """Translations of sample points (nodes and offset masses) from the coordinates.
 
     ``u_g = T (E q)`` with ``E`` the recovery of condensed massless DOFs
-    (``u_o = X u_a``), then a sample rides rigidly on its node:
+    (``u_o = X u_a``; none above the condensation limit, where the massless DOFs are
+    coordinates themselves), then a sample rides rigidly on its node:
     ``u = u_node + theta_node x offset``.
 
     Attributes
