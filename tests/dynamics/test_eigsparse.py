@@ -148,3 +148,43 @@ def test_block_fallback_matches_arpack_and_a_dense_solve(monkeypatch):
     np.testing.assert_allclose(block.omega[6:], dense.omega[6:30], rtol=1e-7)
     m = s.mass.toarray()
     np.testing.assert_allclose(block.phi.T @ m @ block.phi, np.eye(30), atol=1e-9)
+
+
+def test_symmetric_lu_is_kept_only_where_diagonal_pivots_are_safe():
+    # diagonal pivots of a positive definite matrix (Cholesky's) solve it; an indefinite
+    # matrix whose diagonal pivots lose it (a tiny pivot: growth 1e18) is left to partial
+    # pivoting (None)
+    from microg.dynamics.eigsparse import _symmetric_lu
+
+    rng = np.random.default_rng(3)
+    a = rng.standard_normal((40, 40))
+    spd = sp.csc_matrix(a @ a.T + 40 * np.eye(40))
+    lu = _symmetric_lu(spd)
+    assert lu is not None
+    b = rng.standard_normal(40)
+    np.testing.assert_allclose(spd @ lu.solve(b), b, rtol=0, atol=1e-12 * np.abs(b).max())
+    tiny = sp.csc_matrix(np.kron(np.eye(20), [[1e-18, 1.0], [1.0, 1e-18]]))
+    assert _symmetric_lu(tiny) is None
+
+
+def test_singular_mass_pencil_solves_with_exact_rigid_modes_and_unit_modal_masses():
+    # a free-free spring chain whose every other coordinate is massless (a lumped model's
+    # rotations kept as coordinates): the finite modes are those of the chain with the
+    # massless coordinates condensed (springs in series), solved densely as the truth
+    n = 801  # > DENSE_MAX: inverse iteration
+    k = np.linspace(1.0, 3.0, n - 1)
+    K = sp.diags([np.r_[k, 0] + np.r_[0, k], -k, -k], [0, 1, -1], format="csr")
+    m = np.where(np.arange(n) % 2 == 0, 1.0 + 0.5 * np.sin(np.arange(n)), 0.0)
+    M = sp.diags(m, format="csr")
+    sol = solve_sparse(M, K, np.ones((n, 1)), n_modes=12)
+    assert sol.rigid.sum() == 1 and sol.omega[0] == 0.0
+    mass_idx = np.flatnonzero(m > 0)
+    kc = 1.0 / (1.0 / k[0::2] + 1.0 / k[1::2])  # two springs in series between masses
+    Kc = np.diag(np.r_[kc, 0] + np.r_[0, kc]) - np.diag(kc, 1) - np.diag(kc, -1)
+    w2 = np.linalg.eigvalsh(Kc / np.sqrt(np.outer(m[mass_idx], m[mass_idx])))
+    np.testing.assert_allclose(sol.omega[1:12] ** 2, w2[1:12], rtol=1e-9)
+    phi = sol.phi
+    np.testing.assert_allclose(phi.T @ (M @ phi), np.eye(12), atol=1e-10)
+    # the massless coordinates hold their static solution: K_oo x_o = -K_oa x_a
+    res = (K @ phi - (M @ phi) * sol.omega**2)[m == 0]
+    assert np.abs(res).max() <= 1e-9 * np.abs(K @ np.abs(phi)).max()

@@ -503,10 +503,102 @@ def test_acceleration_map_runs_on_a_graph_structure():
     assert np.all(np.isfinite(amap.measure())) and amap.measure().max() > 0
 
 
-def test_condensation_limit_is_an_input_error():
-    with pytest.raises(InputError, match="beyond the limit of 5") as exc:
-        build_frame(_truss_loop("lumped"), condense_max=5)
-    assert "consistent" in str(exc.value)
+def _plate_deck(path, nx, ny, lx=2.0, ly=1.3):
+    """A free-free lumped CQUAD4 plate (nx x ny elements) with an offset CONM2 at grid 1."""
+    lines = ["BEGIN BULK", "MAT1,1,7.0+10,,0.3,2700.", "PSHELL,1,1,0.01,1,,1"]
+
+    def gid(i, j):
+        return 1 + i + (nx + 1) * j
+
+    for j in range(ny + 1):
+        for i in range(nx + 1):
+            lines.append(f"GRID,{gid(i, j)},,{lx * i / nx:.6f},{ly * j / ny:.6f},0.")
+    for e, (i, j) in enumerate(((i, j) for j in range(ny) for i in range(nx)), start=1):
+        lines.append(
+            f"CQUAD4,{e},1,{gid(i, j)},{gid(i + 1, j)},{gid(i + 1, j + 1)},{gid(i, j + 1)}"
+        )
+    lines += ["CONM2,90001,1,,5.0,0.01,0.02,0.03", "ENDDATA"]
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def test_above_the_condensation_limit_massless_dofs_stay_coordinates(tmp_path):
+    # the same lumped plate (121 grids: 363 translations with mass, 726 massless rotations)
+    # condensed (dense, 365 DOFs with the CONM2's) and kept (sparse, 1091 DOFs, a singular M):
+    # the pencils have the same finite eigenvalues, so the two solvers (solve_dense on the
+    # condensed one, solve_sparse's inverse iteration on the other) must agree to their
+    # rounding (measured 3.8e-11 on the frequencies)
+    from microg.models.bdf import load_bdf
+
+    g = load_bdf(_plate_deck(tmp_path / "plate.dat", 10, 10), units="m, N, s")
+    dense = build_frame(g)
+    kept = build_frame(g, condense_max=100)
+    assert not dense.is_sparse and dense.meta["condensed"] > 0 and dense.meta["massless_kept"] == 0
+    assert kept.is_sparse and kept.meta["condensed"] == 0
+    n_massless = kept.meta["massless_kept"]
+    assert n_massless == dense.meta["condensed"] and kept.n_dof == dense.n_dof + n_massless
+    assert any("kept as coordinates" in w for w in kept.meta["warnings"])
+    # the massless rows and columns of M are exactly zero (a positive semi-definite mass)
+    m_rows = np.asarray(abs(kept.mass).sum(axis=1)).ravel()
+    assert np.count_nonzero(m_rows == 0) == n_massless
+    assert kept.samples.condensed.size == 0 and kept.samples.recovery.shape[0] == 0
+    assert kept.meta["damping"].shape == kept.stiffness.shape
+    # mass properties come from the uncondensed mass either way
+    assert kept.total_mass == dense.total_mass
+    np.testing.assert_array_equal(kept.center_of_mass, dense.center_of_mass)
+    # the exact rigid rows, restricted to the kept coordinates, are annihilated by K
+    for d, r in kept.rigid_body.items():
+        kr = kept.stiffness @ r
+        assert np.linalg.norm(kr) <= 1e-9 * np.linalg.norm(abs(kept.stiffness) @ np.abs(r)), d
+
+    md, mk = solve_modes(dense, 24), solve_modes(kept, 24)
+    assert kept.n_dof > 500  # solve_sparse's inverse iteration, not the dense solver
+    assert md.n_rigid == mk.n_rigid == 6 and np.all(mk.omega[:6] == 0.0)
+    np.testing.assert_allclose(mk.freq_hz[6:], md.freq_hz[6:], rtol=1e-8)
+    # mass normalisation on the singular mass, and completeness of the rigid participation
+    gram = mk.phi.T @ (kept.mass @ mk.phi)
+    np.testing.assert_allclose(gram, np.eye(24), atol=1e-9)
+    for d in ("x", "y", "z"):
+        assert mk.effective_mass[d].sum() == pytest.approx(kept.total_mass, rel=1e-12)
+    # mode shapes at every sample (all grids and the offset mass) and through the point maps
+    # of grids: the same motion (each shape's sign taken from the samples)
+    el = np.arange(6, 24)
+    gap = np.diff(md.freq_hz[6:]) / md.freq_hz[7:]
+    assert gap.min() > 1e-3  # no repeated frequency: each shape is defined up to its sign
+    assert kept.samples.labels == dense.samples.labels
+    sd = dense.samples.displacement(md.phi[:, el]).reshape(-1, el.size)
+    sk = kept.samples.displacement(mk.phi[:, el]).reshape(-1, el.size)
+    sign = np.sign(np.sum(sd * sk, axis=0))
+    phi_k = mk.phi[:, el] * sign
+    np.testing.assert_allclose(sk * sign, sd, rtol=0, atol=1e-7 * np.abs(sd).max())
+    for name in ("grid:1", "grid:61", "grid:121"):
+        pd, pk = dense.points[name], kept.points[name]
+        np.testing.assert_array_equal(pk.position, pd.position)
+        for a, b in ((pd.translation, pk.translation), (pd.rotation, pk.rotation)):
+            ref = a @ md.phi[:, el]
+            np.testing.assert_allclose(b @ phi_k, ref, rtol=0, atol=1e-7 * np.abs(ref).max())
+
+
+def test_above_the_condensation_limit_small_lumped_model_solves_densely():
+    # forced above the limit, the small truss loop keeps its massless rotations: solve_dense
+    # (graded, massless coordinates condensed there) gives the condensed model's frequencies
+    g = _truss_loop("lumped")
+    a, b = build_frame(g), build_frame(g, condense_max=5)
+    assert b.is_sparse and b.meta["massless_kept"] == a.meta["condensed"] > 0
+    ma, mb = solve_modes(a), solve_modes(b)
+    assert ma.n_rigid == mb.n_rigid == 6
+    assert mb.n_modes == ma.n_modes == a.n_dof  # the finite modes only (measured 4e-14)
+    np.testing.assert_allclose(mb.freq_hz[6:], ma.freq_hz[6:], rtol=1e-8)
+
+
+def test_massless_mechanism_is_refused_above_the_condensation_limit():
+    # a straight chain of beams without torsional inertia: the rotation about its axis has
+    # neither mass nor stiffness (K_oo singular), refused whether condensed or kept
+    g = _chain(4, section=_section(polar_mass_kg_m=0.0), mass="lumped")
+    for cm in (10**6, 5):
+        with pytest.raises(InputError, match="massless part of the model is a mechanism") as e:
+            build_frame(g, condense_max=cm)
+        assert "n0:rx" in str(e.value)
 
 
 def test_station_graph_gives_build_fem_acceleration_map():

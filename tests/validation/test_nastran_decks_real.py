@@ -79,6 +79,52 @@ def test_replicated_cards_expand_and_the_slender_bar_solves():
     np.testing.assert_allclose(md.freq_hz[6:8], ref, rtol=0.02)
 
 
+def test_cant_beam_with_its_own_mass_names_the_massless_rotation_about_its_axis():
+    # read as written (PARAM,COUPMASS,1: NASTRAN's coupled CBAR mass, which has no torsional
+    # inertia), the straight bar's rotation about its own axis has neither mass nor stiffness:
+    # the rigid rotation rx carries no mass at all (every grid lies on the axis), so no
+    # mass-normalised rx mode exists and K_oo of the massless set is singular.  Beyond the
+    # dense limit the massless DOFs are no longer refused for their number (41,110 DOFs with
+    # mass) but this massless mechanism still is, naming the rotations.  (NASTRAN's own run,
+    # EIGRL ND=4, kept 4 modes in pyyeti's OP2.)
+    g = load_bdf(DATA / "extseout_cant_beam.dat", units="mm, N, s")
+    with pytest.raises(InputError, match="massless part of the model is a mechanism") as exc:
+        discretize(g)
+    assert "grid:1:rx, grid:2:rx" in str(exc.value) and "beyond the limit" not in str(exc.value)
+
+
+def test_cant_beam_as_lumped_cbeams_solves_sparsely_with_massless_rotations(tmp_path):
+    # the same 8,221 elements as CBEAMs with NASTRAN's default lumped mass (no COUPMASS): half
+    # of each element's mass on each end's translations, half its polar moment on the axial
+    # rotation, the 16,444 bending rotations massless.  Condensed they would leave 41,110
+    # DOFs (dense: refused before); they are kept as coordinates, M singular, and solved
+    # sparsely.  Truth: Euler-Bernoulli (as the consistent-mass test above).  Lumping errs by
+    # O((beta Le)^2) ~ 3e-7 at Le/L = 1/8221; the round-off bound of the test above (a
+    # stiffness spread of 4e15 ~ 1/eps, ~1e-2 on the lowest pair) allows more than was
+    # measured here (9.9e-5 and 4.1e-4: the two planes split by 5e-4): 5e-3 is 12x the
+    # larger, while a missing or doubled mass term is off by 20% or more
+    text = (DATA / "extseout_cant_beam.dat").read_text()
+    text = (
+        text.replace("PARAM,COUPMASS,1\n", "")
+        .replace("CBAR,", "CBEAM,")
+        .replace(
+            "PBAR,100,300,12.566,12.566,12.566,25.133", "PBEAM,100,300,12.566,12.566,12.566,,25.133"
+        )
+    )
+    deck = tmp_path / "cant_beam_cbeam.dat"
+    deck.write_text(text)
+    g = load_bdf(deck, units="mm, N, s")
+    assert g.mass_formulation == "lumped" and len(g.beams) == 8221
+    s = discretize(g)
+    assert s.is_sparse and s.meta["condensed"] == 0 and s.meta["massless_kept"] == 16444
+    md = solve_modes(s, 10)
+    assert md.n_rigid == 6 and np.all(md.omega[:6] == 0.0)
+    ref = 4.730040744862704**2 / (2 * np.pi * 82210.0**2) * np.sqrt(6.894e7 / 2.74e-6)
+    np.testing.assert_allclose(md.freq_hz[6:8], ref, rtol=5e-3)
+    for d in ("x", "y", "z"):
+        assert md.effective_mass[d].sum() == pytest.approx(s.total_mass, rel=1e-10)
+
+
 def test_slender_bar_l_over_r_1e5_against_beam_theory(tmp_path):
     # a free-free bar of 200 CBARs along a skew line, L/r = 1e5: every rigid-body vector
     # passes the rigid test (no false mechanism), and the first bending pair is

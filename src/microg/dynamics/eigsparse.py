@@ -13,7 +13,8 @@ Method (the rigid span is never left to the eigensolver):
    Geradin & Rixen, *Mechanical Vibrations*, Sec. 4.3.  ``G`` is the exact tree flexibility
    of a frame model (:class:`~microg.structure.fem.FrameTree`: O(n), no factorisation, no
    round-off growth with the mesh) or, for any other structure, the inverse of ``K`` with
-   ``r`` isostatic support coordinates held (one sparse LU with a symmetric ordering).
+   ``r`` isostatic support coordinates held (one sparse LU with a symmetric ordering and
+   diagonal pivots where they are safe, :func:`_symmetric_lu`; partial pivoting otherwise).
    ARPACK (``scipy.sparse.linalg.eigsh``, mode 3) runs on it in the M inner product; ``M``
    may be singular (massless coordinates: their directions have ``mu = 0``).  An unstable
    mode (a negative stiffness) is a negative ``mu``, found like the others.
@@ -241,10 +242,12 @@ def _isostatic_inverse(K: sp.csr_matrix, B: np.ndarray, labels: tuple[str, ...] 
     sup = support_coordinates(B)
     keep = np.setdiff1d(np.arange(n), sup)
     kk = K[keep][:, keep].tocsc()
-    try:
-        lu = spla.splu(kk, permc_spec="MMD_AT_PLUS_A")
-    except RuntimeError:  # exactly singular
-        lu = None
+    lu = _symmetric_lu(kk)
+    if lu is None:
+        try:
+            lu = spla.splu(kk, permc_spec="MMD_AT_PLUS_A")
+        except RuntimeError:  # exactly singular
+            lu = None
     if lu is not None:
         d = np.abs(lu.U.diagonal())
         if d.size and d.min() <= 1e3 * _EPS * d.max():
@@ -267,6 +270,41 @@ def _isostatic_inverse(K: sp.csr_matrix, B: np.ndarray, labels: tuple[str, ...] 
         return x.reshape(np.shape(y))
 
     return apply
+
+
+#: backward error of one solve below which the LU of :func:`_symmetric_lu` is kept
+SYMMETRIC_LU_TOL = 1e-10
+
+
+def _symmetric_lu(a: sp.csc_matrix) -> spla.SuperLU | None:
+    """SuperLU with the diagonal as pivots (SymmetricMode), or None where it is not safe.
+
+    The stiffness with the isostatic supports held is symmetric and, for a free-free
+    structure without negative stiffness, positive definite: the diagonal pivots of its
+    minimum-degree ordering are stable (Cholesky's), while SuperLU's default partial
+    pivoting leaves that ordering for off-diagonal pivots wherever a row's largest entry is
+    not on the diagonal (a shell's massless rotations beside its drilling penalty): on a
+    lumped 45 x 45 CQUAD4 plate (12,696 DOFs) 59 million factor entries and 30 s, against
+    1.9 million and 0.14 s with diagonal pivots (measured).  Kept only when every pivot is
+    well away from zero and one solve has a backward error below :data:`SYMMETRIC_LU_TOL`;
+    otherwise (a pivot lost to an indefinite or singular matrix) the caller's partial
+    pivoting decides.
+    """
+    try:
+        lu = spla.splu(
+            a, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options={"SymmetricMode": True}
+        )
+    except RuntimeError:
+        return None
+    d = np.abs(lu.U.diagonal())
+    if not d.size or not np.all(np.isfinite(d)) or d.min() <= 1e3 * _EPS * d.max():
+        return None
+    b = np.random.default_rng(2).standard_normal(a.shape[0])
+    x = lu.solve(b)
+    den = np.linalg.norm(abs(a) @ np.abs(x)) + np.linalg.norm(b)
+    if not np.all(np.isfinite(x)) or np.linalg.norm(a @ x - b) > SYMMETRIC_LU_TOL * den:
+        return None
+    return lu
 
 
 def _near_null(a: sp.csc_matrix) -> np.ndarray:

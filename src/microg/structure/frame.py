@@ -16,9 +16,15 @@ Degrees of freedom:
    the equations of the massless set are static, ``u_o = -K_oo^-1 K_oa u_a``, so
    ``K_r = K_aa - K_ao K_oo^-1 K_oa`` and ``M_r = M_aa`` have the same finite eigenvalues as
    the full pencil, and forces on the massless set map exactly through the point maps.  The
-   condensed stiffness is dense: at most :data:`CONDENSE_MAX` retained DOFs (a documented
-   limit: a larger lumped model needs ``mass="consistent"``, or a solver that accepts a
-   singular mass matrix).
+   condensed stiffness is dense, so this is done up to :data:`CONDENSE_MAX` retained DOFs
+   (``condense_max``).  Above that limit the massless DOFs are **kept as coordinates**: K
+   stays sparse and M is sparse and positive semi-definite, its massless rows and columns
+   exactly zero; :func:`~microg.dynamics.eigsparse.solve_sparse` solves that pencil (the
+   massless directions have ``mu = 0`` in its inverse form, and its Rayleigh-Ritz step
+   gives the shapes their static massless part).  ``meta["condensed"]`` is then 0,
+   ``meta["massless_kept"]`` counts them, and a warning says so.  Either way a massless
+   mechanism (``K_oo`` singular: e.g. a straight line of CBARs, which have no torsional
+   inertia, turning about its axis) is refused, naming the DOFs.
 3. **Rigid-body vectors** are the exact unit translations and rotations about the centre of
    mass (as :mod:`microg.structure.fem`'s), restricted to the retained DOFs (a rigid motion
    satisfies every link exactly).
@@ -118,7 +124,8 @@ class FrameSamples:
     """Translations of sample points (nodes and offset masses) from the coordinates.
 
     ``u_g = T (E q)`` with ``E`` the recovery of condensed massless DOFs
-    (``u_o = X u_a``), then a sample rides rigidly on its node:
+    (``u_o = X u_a``; none above the condensation limit, where the massless DOFs are
+    coordinates themselves), then a sample rides rigidly on its node:
     ``u = u_node + theta_node x offset``.
 
     Attributes
@@ -331,17 +338,20 @@ def build_frame(
         Apply the model's single-point constraints (for validation against clamped decks);
         the structure then has no rigid-body vectors.
     condense_max : int
-        Largest number of retained DOFs when massless DOFs are condensed (dense).
+        Largest number of retained DOFs when massless DOFs are condensed (dense); above it
+        they are kept as coordinates (sparse K, singular sparse M).
 
     Returns
     -------
     Structure
         Method ``"fem"``; sparse CSR matrices, or dense ones when massless DOFs were
-        condensed; a :class:`PointMap` per named point (and per node on lookup by name),
-        exact rigid-body vectors, :class:`FrameSamples` as ``samples``; ``meta`` carries the
-        damping matrices (``damping``, ``structural_damping``, in the coordinates), the
-        ``transform`` from the independent set to the 6 DOFs per node (``u_g = transform @
-        samples.expand(q)``), the removed and condensed DOF counts and ``warnings``.
+        condensed (at most ``condense_max`` retained DOFs); a :class:`PointMap` per named
+        point (and per node on lookup by name), exact rigid-body vectors,
+        :class:`FrameSamples` as ``samples``; ``meta`` carries the damping matrices
+        (``damping``, ``structural_damping``, in the coordinates), the ``transform`` from
+        the independent set to the 6 DOFs per node (``u_g = transform @
+        samples.expand(q)``), the removed and condensed DOF counts, ``massless_kept``
+        (massless DOFs kept as coordinates above the limit) and ``warnings``.
     """
     import scipy.sparse as sp
     import scipy.sparse.linalg as spla
@@ -437,42 +447,62 @@ def build_frame(
     Kaa = Kn[retained][:, retained]
     Maa = Mn[retained][:, retained]
     X = np.zeros((0, retained.size))
+    kept_massless = 0
+    K_out: Any
+    M_out: Any
+    C_out: Any
+    G_out: Any
     if massless.size:
-        if retained.size > condense_max:
-            raise InputError(
-                f"{massless.size} DOFs carry no mass (lumped mass: bending rotations; NASTRAN's "
-                "coupled CBAR mass: rotations about the bars' axes); condensing "
-                f"them exactly leaves {retained.size} DOFs, a dense matrix beyond the limit of "
-                f"{condense_max}",
-                where="mass",
-                fix="use mass='consistent' (a NASTRAN deck: PARAM,COUPMASS,1 read with "
-                "coupled_mass='consistent') or add rotary inertia",
-            )
+        sparse_path = retained.size > condense_max
         Koo = Kn[massless][:, massless].tocsc()
-        Koa = Kn[massless][:, retained].toarray()
         try:
             lu = spla.splu(Koo)
             piv = np.abs(lu.U.diagonal())
             singular = piv.min() <= 1e-12 * piv.max()
-            X = -lu.solve(Koa)
+            if not sparse_path:
+                X = -lu.solve(Kn[massless][:, retained].toarray())
         except RuntimeError:
             singular = True
         if singular or not np.all(np.isfinite(X)):
             d = _weak_dofs(Koo)
             labs = ", ".join(ind_labels[massless[i]] for i in d[:6])
+            more = f" and {len(d) - 6} more" if len(d) > 6 else ""
             raise InputError(
-                f"a massless part of the model is a mechanism (DOFs {labs} have neither mass "
-                "nor stiffness against it)",
+                f"a massless part of the model is a mechanism (DOFs {labs}{more} have neither "
+                "mass nor stiffness against it)",
                 where=graph.source or graph.name,
                 fix="connect it, or give it mass",
             )
+    if massless.size and retained.size > condense_max:
+        # above the dense limit the massless DOFs stay coordinates: sparse K and a sparse,
+        # positive semi-definite M whose massless rows and columns are exactly zero (the
+        # turned null directions of coupled blocks carry rounding otherwise); the sparse
+        # solver's inverse form gives their directions mu = 0
+        kept_massless = int(massless.size)
+        warnings.append(
+            f"{kept_massless} DOFs carry no mass (rotations without rotary inertia: lumped "
+            "mass, shells, NASTRAN's coupled CBAR mass about the bars' axes); condensing them "
+            f"would leave {retained.size} DOFs, a dense matrix beyond the limit of "
+            f"{condense_max}, so they are kept as coordinates (a singular mass matrix) and the "
+            "model is solved sparsely"
+        )
+        retained = live
+        massless = live[:0]
+        X = np.zeros((0, live.size))
+        keep_m = np.ones(Mn.shape[0])
+        keep_m[live[null[live]]] = 0.0
+        Dm = sp.diags(keep_m)
+        Mn = sp.csr_matrix(Dm @ Mn @ Dm)
+        Mn.eliminate_zeros()
+        K_out, M_out = Kn[live][:, live].tocsr(), Mn[live][:, live].tocsr()
+        C_out = Cn[live][:, live].tocsr()
+        G_out = Gn[live][:, live].tocsr()
+    elif massless.size:
         Kd = Kaa.toarray() + np.asarray(Kn[retained][:, massless] @ X)
-        K_out: Any = 0.5 * (Kd + Kd.T)
-        M_out: Any = Maa.toarray()
-        Cd = _condense_full(Cn, retained, massless, X)
-        Gd = _condense_full(Gn, retained, massless, X)
-        C_out: Any = Cd
-        G_out: Any = Gd
+        K_out = 0.5 * (Kd + Kd.T)
+        M_out = Maa.toarray()
+        C_out = _condense_full(Cn, retained, massless, X)
+        G_out = _condense_full(Gn, retained, massless, X)
     else:
         K_out, M_out = Kaa.tocsr(), Maa.tocsr()
         C_out = Cn[retained][:, retained].tocsr()
@@ -527,6 +557,7 @@ def build_frame(
         "n_rigid_elements": len(graph.rigid_links) + len(graph.interpolations),
         "removed": int(unconnected.sum()),
         "condensed": int(massless.size),
+        "massless_kept": kept_massless,
         "constraints_applied": tuple(applied),
         "transform": T,
         "damping": C_out,
@@ -743,7 +774,26 @@ def _weak_dofs(Koo: sp.csc_matrix) -> list[int]:
         if null.size:
             weight = np.max(np.abs(null), axis=1)
             return [int(i) for i in np.flatnonzero(weight > 0.1 * weight.max())]
-    return [int(i) for i in np.flatnonzero(np.asarray(abs(Koo).sum(axis=1)).ravel() == 0)]
+    zero = [int(i) for i in np.flatnonzero(np.asarray(abs(Koo).sum(axis=1)).ravel() == 0)]
+    if zero or Koo.shape[0] <= 3000:
+        return zero
+    # a large K_oo (a model above the dense limit): a few inverse iterations with a tiny
+    # shift find the motion it barely resists
+    import scipy.sparse as sp
+    import scipy.sparse.linalg as spla
+
+    n = Koo.shape[0]
+    scale = float(abs(Koo).max()) or 1.0
+    try:
+        lu = spla.splu(sp.csc_matrix(Koo + 1e-10 * scale * sp.identity(n)))
+    except RuntimeError:
+        return []
+    v = np.random.default_rng(0).standard_normal(n)
+    for _ in range(4):
+        v = lu.solve(v)
+        v /= np.linalg.norm(v)
+    weight = np.abs(v)
+    return [int(i) for i in np.flatnonzero(weight > 0.1 * weight.max())]
 
 
 def _samples(

@@ -61,7 +61,8 @@ class Structure:
     Attributes
     ----------
     mass : ndarray or sparse, shape (n, n)
-        Generalized mass matrix (symmetric positive definite), SI.
+        Generalized mass matrix (symmetric positive definite; positive semi-definite for
+        a sparse frame model that keeps its massless DOFs as coordinates), SI.
     stiffness : ndarray or sparse, shape (n, n)
         Generalized stiffness matrix (symmetric positive semi-definite), SI.
     dof_labels : tuple of str
