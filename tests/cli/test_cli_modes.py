@@ -221,3 +221,34 @@ def test_a_decks_spc_is_said_and_applied_on_request(capsys):
     assert clamped["modes"][0]["freq_hz"] == pytest.approx(456.6603, rel=5e-3)
     rc, _, err = _run(capsys, "ioc", "--constrained")
     assert rc == 2 and "--constrained" in err and "\n" not in err.strip()
+
+
+def test_uff_export_of_a_deck_keeps_its_grids(capsys, tmp_path):
+    # a NASTRAN deck (frame elements, no named points): its grids are the UFF's nodes, by
+    # their own ids, and the file read back gives the same frequencies (6 printed digits:
+    # 1e-5) and, at a grid, the deck's own shape (the structure's point map of that grid)
+    from microg.dynamics.modes import solve_modes
+    from microg.models.load import load_model
+    from microg.models.uff import modal_model_from_uff
+    from microg.structure.discretize import discretize
+
+    deck = NASTRAN / "rdop2gpwg_1.dat"
+    unv = tmp_path / "deck.unv"
+    rc, out, err = _run(capsys, str(deck), "--units", "in,lbf,s", "--n-modes", "12", "--uff",
+                        str(unv), "--json")  # fmt: skip
+    assert rc == 0 and unv.is_file(), err
+    fe = np.array([m["freq_hz"] for m in json.loads(out)["modes"]])
+    back = modal_model_from_uff(unv)
+    grids = [int(i) for i in back.grid_ids]
+    st = discretize(load_model(deck, units="in,lbf,s"))
+    assert grids == sorted(int(lab.split(":")[1]) for lab in st.samples.labels)
+    rc, out, err = _run(capsys, str(unv), "--json")
+    assert rc == 0, err
+    np.testing.assert_allclose([m["freq_hz"] for m in json.loads(out)["modes"]], fe, rtol=1e-5)
+    md = solve_modes(st, 12)
+    j = 8  # an elastic mode; the sign of a shape is arbitrary
+    name = f"grid:{grids[3]}"
+    mine = st.points[name].translation @ md.phi[:, j]
+    theirs = back.phi[3, :3, j]
+    s = np.sign(mine @ theirs)
+    np.testing.assert_allclose(s * theirs, mine, rtol=0, atol=1e-5 * np.abs(mine).max())

@@ -592,13 +592,22 @@ def test_above_the_condensation_limit_small_lumped_model_solves_densely():
 
 
 def test_massless_mechanism_is_refused_above_the_condensation_limit():
-    # a straight chain of beams without torsional inertia: the rotation about its axis has
-    # neither mass nor stiffness (K_oo singular), refused whether condensed or kept
+    # a straight chain of beams without torsional inertia, one of them released in torsion at
+    # one end: the rotation of the chain about its axis is a massless rigid motion (held),
+    # but the two halves turning against each other is a massless mechanism (K_oo singular
+    # once the rigid one is held), refused whether condensed or kept
+    import dataclasses
+
     g = _chain(4, section=_section(polar_mass_kg_m=0.0), mass="lumped")
+    # e2's end a released in torsion (a NASTRAN pin flag 4): no torsion across n2
+    beams = tuple(
+        dataclasses.replace(b, releases=("4", "")) if b.name == "e2" else b for b in g.beams
+    )
+    g = dataclasses.replace(g, beams=beams)
     for cm in (10**6, 5):
         with pytest.raises(InputError, match="massless part of the model is a mechanism") as e:
             build_frame(g, condense_max=cm)
-        assert "n0:rx" in str(e.value)
+        assert ":rx" in str(e.value)
 
 
 def test_station_graph_gives_build_fem_acceleration_map():
@@ -620,3 +629,51 @@ def test_station_graph_gives_build_fem_acceleration_map():
     np.testing.assert_allclose(
         maps[1].measure(), maps[0].measure(), rtol=0, atol=1e-6 * maps[0].measure().max()
     )
+
+
+def _bar_line(tmp_path, name, direction, spc_rx=False, n=12):
+    """A free-free line of lumped-mass CBARs (no rotary inertia anywhere) along ``direction``."""
+    from microg.models.bdf import load_bdf
+
+    d = np.asarray(direction, float) / np.linalg.norm(direction)
+    v = np.cross(d, [0.3, 0.5, 0.8])
+    lines = ["BEGIN BULK", "MAT1,1,7.0+10,,0.3,2700.", "PBAR,10,1,1.0-4,2.0-9,3.0-9,4.0-9"]
+    for i in range(n + 1):
+        x = 0.25 * i * d
+        lines.append(f"GRID,{i + 1},,{x[0]:.12f},{x[1]:.12f},{x[2]:.12f}")
+    for i in range(n):
+        lines.append(f"CBAR,{i + 1},10,{i + 1},{i + 2},{v[0]:.9f},{v[1]:.9f},{v[2]:.9f}")
+    if spc_rx:
+        lines.append(f"SPC1,1,4,1,THRU,{n + 1}")
+    lines.append("ENDDATA")
+    path = tmp_path / f"{name}.bdf"
+    path.write_text("\n".join(lines) + "\n")
+    return load_bdf(path, units="m, N, s")
+
+
+def test_a_massless_rigid_rotation_is_held_not_called_a_mechanism(tmp_path):
+    # lumped CBAR mass has no rotary inertia: the rotation of a straight line about itself has
+    # neither mass nor stiffness.  It is no mode (5 rigid-body modes), and holding one DOF of
+    # it changes no finite mode.  Truth: the same line along x with every grid's rx held by
+    # SPC (torsion carries no inertia, so no finite mode moves rx): equal frequencies, and the
+    # same line turned in space (a combination of rx, ry, rz is held): equal frequencies
+    from microg.dynamics.modes import solve_modes
+
+    along_x = build_frame(_bar_line(tmp_path, "x", [1.0, 0.0, 0.0]))
+    said = [w for w in along_x.meta["warnings"] if "rigid-body motion(s) move only" in w]
+    assert len(said) == 1 and "leaving 5 rigid-body modes" in said[0]
+    free = solve_modes(along_x)
+    assert free.n_rigid == 5 and np.all(free.omega[free.rigid] == 0.0)
+    held = solve_modes(build_frame(_bar_line(tmp_path, "h", [1, 0, 0], True), constrained=True))
+    w_free = free.omega[~free.rigid]
+    w_held = held.omega[held.omega > 1e-6 * held.omega.max()]
+    assert w_free.size == w_held.size
+    # the same finite eigenproblem reached two ways, each solved densely (~50 coordinates):
+    # round-off of a stiffness spread ~1e6 (EA/L against the lowest bending): 1e-9
+    np.testing.assert_allclose(w_free, w_held, rtol=1e-9)
+    skew = solve_modes(build_frame(_bar_line(tmp_path, "s", [1.0, 2.0, 0.5])))
+    assert skew.n_rigid == 5
+    np.testing.assert_allclose(skew.omega[~skew.rigid], w_free, rtol=1e-9)
+    # the effective masses still sum to the model's mass in each translation
+    for k in "xyz":
+        assert np.sum(free.effective_mass[k]) == pytest.approx(along_x.total_mass, rel=1e-9)

@@ -50,6 +50,8 @@ __all__ = [
 ]
 
 _PRECISIONS = ("single", "double")
+#: a NASTRAN grid's sample label (its id kept in the export)
+_GRID_LABEL = re.compile(r"grid:(\d+)")
 
 
 @dataclass(frozen=True)
@@ -398,10 +400,23 @@ def _from_modes(
     tr_l, rot_l, xyz_l = [], [], []
     if samples is not None and hasattr(samples, "phi_t"):
         raise TypeError("modes of a modal model: pass the ModalModel itself")
+    grid_ids: list[int] | None = None
     if samples is not None and hasattr(samples, "rot_index"):
         tr_l.append(np.asarray(samples.displacement(phi)))  # (p, 3, m), offsets included
         rot_l.append(phi[np.asarray(samples.rot_index)])
         xyz_l.append(np.asarray(samples.position, float))
+    elif samples is not None and hasattr(samples, "rows") and len(samples):
+        # a frame model's samples (microg.structure.frame.FrameSamples): the 6 DOFs of each
+        # sample's node from the coordinates, translations carried to the sample's offset
+        p = len(samples)
+        u6 = np.asarray(samples.rows @ samples.expand(phi)).reshape(p, 6, -1)
+        tr_l.append(np.asarray(samples.displacement(phi)).reshape(p, 3, -1))
+        rot_l.append(u6[:, 3:])
+        xyz_l.append(np.asarray(samples.position, float))
+        # a NASTRAN deck's grids keep their ids when every sample is a grid
+        got = [_GRID_LABEL.fullmatch(str(lab)) for lab in samples.labels]
+        if all(got) and len({int(g.group(1)) for g in got if g}) == p:
+            grid_ids = [int(g.group(1)) for g in got if g]
     maps = list(st.points.values())
     if maps:
         tr_l.append(np.stack([p.translation @ phi for p in maps]))
@@ -412,7 +427,11 @@ def _from_modes(
     shapes = np.concatenate([np.concatenate(tr_l), np.concatenate(rot_l)], axis=1)
     xyz = np.concatenate(xyz_l)
     ids = np.arange(1, xyz.shape[0] + 1, dtype=np.int64)
-    first_point = xyz.shape[0] - len(maps) + 1
+    if grid_ids is not None:
+        # grids by their own ids, the named points after the largest
+        top = max(grid_ids)
+        ids = np.array(grid_ids + [top + 1 + i for i in range(len(maps))], dtype=np.int64)
+    first_point = int(ids[xyz.shape[0] - len(maps)]) if maps else int(ids[-1]) + 1
     named = {p.name: first_point + i for i, p in enumerate(maps)}
     name = str(st.meta.get("model", "microg")) if st.meta else "microg"
     return ids, xyz, np.asarray(modes.omega), shapes, named, name
@@ -432,8 +451,9 @@ def write_uff_modes(
     ----------
     modes_or_model : ModalModel or microg.dynamics.modes.Modes
         A modal model (its grids and shapes), or the modes of a microg structure (nodes:
-        the structure's samples -- frame nodes and body masses -- numbered 1.., or its named
-        points when it has no samples).
+        the structure's samples -- frame nodes and body masses, or a deck's grids and the
+        masses off them -- numbered 1.., a deck's grids by their own ids when every sample is
+        a grid; then its named points).
     path : str or Path
         Output file (``.unv``/``.uff``).
     precision : {"single", "double"}

@@ -452,6 +452,30 @@ def build_frame(
     M_out: Any
     C_out: Any
     G_out: Any
+    pinned: list[int] = []
+    if massless.size and not (constrained and applied):
+        massless, pinned = _pin_massless_rigid(
+            rigid_rows(fm.positions, fm.positions.mean(axis=0), scalar, fm.working)[fm.independent]
+            if Q is None
+            else np.asarray(
+                Q.T
+                @ rigid_rows(fm.positions, fm.positions.mean(axis=0), scalar, fm.working)[
+                    fm.independent
+                ]
+            ),
+            retained,
+            massless,
+        )
+        if pinned:
+            live = np.setdiff1d(live, pinned)
+            warnings.append(
+                f"{len(pinned)} rigid-body motion(s) move only DOFs without mass (a line of "
+                "grids without rotary inertia about it: lumped mass, or NASTRAN's coupled CBAR "
+                "mass, which has no torsional inertia): such a motion has neither mass nor "
+                "stiffness, so it is no mode; held at "
+                + ", ".join(ind_labels[j] for j in pinned)
+                + f" (as NASTRAN AUTOSPC), leaving {6 - len(pinned)} rigid-body modes"
+            )
     if massless.size:
         sparse_path = retained.size > condense_max
         Koo = Kn[massless][:, massless].tocsc()
@@ -764,6 +788,57 @@ def _condense_full(A: sp.csr_matrix, a: np.ndarray, o: np.ndarray, X: np.ndarray
     Aoo = A[o][:, o]
     out = Aaa + np.asarray(Aao @ X) + np.asarray(Aao @ X).T + X.T @ np.asarray(Aoo @ X)
     return 0.5 * (out + out.T)
+
+
+def _pin_massless_rigid(
+    r: np.ndarray, retained: np.ndarray, massless: np.ndarray
+) -> tuple[np.ndarray, list[int]]:
+    """Hold one massless DOF of each rigid-body motion that moves no DOF with mass.
+
+    A rigid motion ``z = R c`` that is zero on every coordinate with mass (``R_r c = 0``) has
+    neither mass nor stiffness (``K z = 0``, ``M z = 0``): it is no mode, and it makes the
+    massless block ``K_oo`` singular.  Holding a DOF ``j`` where ``z_j != 0`` removes it and
+    nothing else: every finite mode ``phi`` has the representative ``phi - (phi_j / z_j) z``
+    (also a mode, since ``z`` adds neither energy nor inertia) that is zero at ``j``, so the
+    finite eigenpairs are unchanged.  One DOF per such motion, each where the motion is
+    largest once the earlier ones are held.
+
+    Parameters
+    ----------
+    r : ndarray (n, 6)
+        The rigid-body vectors on the independent coordinates.
+    retained, massless : ndarray of int
+        The coordinates with and without mass.
+
+    Returns
+    -------
+    massless : ndarray of int
+        Without the held DOFs.
+    pinned : list of int
+        The held DOFs (indices of the independent coordinates).
+    """
+    if massless.size == 0:
+        return massless, []
+    rr, ro = r[retained], r[massless]
+    scale = max(float(np.abs(r).max()), 1e-300)
+    # vt is (6, 6) either way; U stays small (n x 6, or n x n only when n < 6)
+    _, s, vt = np.linalg.svd(rr, full_matrices=rr.shape[0] < 6)
+    rank = int(np.count_nonzero(s > 1e-10 * scale * max(1.0, np.sqrt(rr.shape[0]))))
+    c = vt[rank:].T  # combinations of the six motions that move no DOF with mass
+    if c.size == 0:
+        return massless, []
+    z = ro @ c
+    pinned: list[int] = []
+    for k in range(z.shape[1]):
+        col = z[:, k]
+        if np.abs(col).max() <= 1e-10 * scale:
+            continue  # no motion at all (fewer than six independent rigid motions)
+        j = int(np.argmax(np.abs(col)))
+        pinned.append(int(massless[j]))
+        # the later motions, made zero at j (their span is what remains to hold)
+        z[:, k + 1 :] -= np.outer(col / col[j], z[j, k + 1 :])
+    keep = ~np.isin(massless, pinned)
+    return massless[keep], pinned
 
 
 def _weak_dofs(Koo: sp.csc_matrix) -> list[int]:
