@@ -75,6 +75,32 @@ def _progress(args: list[str]) -> bool:
     return len(args) > 1 and args[1] in ("analyze",) and "--no-progress" not in args
 
 
+def test_api_page_studies_block_runs_and_hands_out_numbers(tmp_path: Path, monkeypatch) -> None:
+    # the "Studies" block of docs/api.md, run as written (in a directory holding the
+    # repository's examples/): every expression it shows evaluates to computed values (numpy
+    # arrays, not an uncomputed Dask graph), so what a user copies prints numbers
+    import ast
+    import shutil
+
+    import numpy as np
+
+    text = (ROOT / "docs" / "api.md").read_text(encoding="utf-8")
+    block = text.split("## Studies", 1)[1].split("```python", 1)[1].split("```", 1)[0]
+    shutil.copytree(ROOT / "examples", tmp_path / "examples")
+    monkeypatch.chdir(tmp_path)
+    scope: dict = {}
+    shown = []
+    for stmt in ast.parse(block).body:
+        if isinstance(stmt, ast.Expr):
+            shown.append(eval(compile(ast.Expression(stmt.value), "api.md", "eval"), scope))
+        else:
+            exec(compile(ast.Module([stmt], []), "api.md", "exec"), scope)
+    assert len(shown) == 2
+    margin, summary = shown
+    assert isinstance(margin.data, np.ndarray) and np.all(np.isfinite(margin.data))
+    assert isinstance(summary, dict) and 0.0 <= summary["complying_fraction"] <= 1.0
+
+
 def test_api_page_computes_what_it_shows_of_a_lazy_dataset() -> None:
     # a study's dataset is opened lazily (Dask arrays over zarr): an expression on it printed
     # as written shows an uncomputed array, so the page computes each one it shows
