@@ -12,30 +12,9 @@ import math
 from typing import Any
 
 from microg._io import to_jsonable
+from microg.report.html import criterion_verdict  # the one wording (analyze's page uses it too)
 
 __all__ = ["criterion_verdict", "figure_entries", "render_assessment", "render_quasi_steady"]
-
-
-def criterion_verdict(c: dict[str, Any]) -> tuple[str, str]:
-    """(verdict text, CSS class) of one criterion of the JSON ``criteria`` list, from its fields.
-
-    The words are :meth:`microg.environment.criteria.CriterionVerdict.line`'s: ``judged`` is
-    "complies" or "fails", ``reported`` adds "reported only" (its limit does not enter the
-    verdict), ``undecided`` says so.
-
-    Parameters
-    ----------
-    c : one entry of an observation's ``criteria`` (``status``, ``complies``, ``margin``)
-    """
-    if c.get("status") == "undecided" or c.get("complies") is None:
-        return "undecided", "undecided"
-    margin = c.get("margin")
-    m = f" (margin {margin:.3g})" if isinstance(margin, int | float) else ""
-    if c.get("status") == "judged":
-        return ("complies" + m, "pass") if c["complies"] else ("fails" + m, "fail")
-    if c["complies"]:
-        return "reported only: within its limit" + m, ""
-    return "reported only: exceeds its limit" + m, "warn"
 
 
 def figure_entries(

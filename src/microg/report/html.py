@@ -33,6 +33,7 @@ if TYPE_CHECKING:  # the seed reproduction loads only for its own report (~0.1 s
 __all__ = [
     "VERDICT_WORDS",
     "chart_fragment",
+    "criterion_verdict",
     "environment",
     "id_ranges",
     "plotly_js",
@@ -112,6 +113,28 @@ def _bytecode_cache() -> BytecodeCache | None:
         return None
 
 
+def criterion_verdict(c: dict[str, Any]) -> tuple[str, str]:
+    """(verdict text, CSS class) of one criterion of the JSON ``criteria`` list, from its fields.
+
+    The words are :meth:`microg.environment.criteria.CriterionVerdict.line`'s: ``judged`` is
+    "complies" or "fails", ``reported`` adds "reported only" (its limit does not enter the
+    verdict), ``undecided`` says so.
+
+    Parameters
+    ----------
+    c : one entry of an observation's ``criteria`` (``status``, ``complies``, ``margin``)
+    """
+    if c.get("status") == "undecided" or c.get("complies") is None:
+        return "undecided", "undecided"
+    margin = c.get("margin")
+    m = f" (margin {margin:.3g})" if isinstance(margin, int | float) else ""
+    if c.get("status") == "judged":
+        return ("complies" + m, "pass") if c["complies"] else ("fails" + m, "fail")
+    if c["complies"]:
+        return "reported only: within its limit" + m, ""
+    return "reported only: exceeds its limit" + m, "warn"
+
+
 #: an assessment's verdict (``complies``/``fails``/``undecided``) as a page says it, with its
 #: CSS class
 VERDICT_WORDS = {
@@ -130,8 +153,6 @@ def environment() -> Environment:
         bytecode_cache=_bytecode_cache(),
     )
     env.filters["id_ranges"] = id_ranges
-    from microg.report.environment import criterion_verdict  # one definition, for every page
-
     env.globals["criterion_verdict"] = criterion_verdict
     env.globals["verdict_words"] = VERDICT_WORDS
     return env
