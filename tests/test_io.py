@@ -248,6 +248,38 @@ def test_killed_at_random_points_leaves_one_complete_run(tmp_path: Path) -> None
     assert _listing(out) == [RUN_MARKER, "report.html"]
 
 
+_KILLED_IN_MARKER = textwrap.dedent(
+    """
+    import os, pathlib, sys
+    from microg._io import RUN_MARKER, write_run_directory
+    out = sys.argv[1]
+    write_run_directory(out, {"a.txt": "first"}, where="out")
+    real = pathlib.Path.write_text
+    def half(self, data, *args, **kwargs):
+        if self.name.startswith(RUN_MARKER):  # killed halfway through writing the marker
+            real(self, data[: len(data) // 2], *args, **kwargs)
+            os._exit(9)
+        return real(self, data, *args, **kwargs)
+    pathlib.Path.write_text = half
+    write_run_directory(out, {"a.txt": "second", "b.txt": "x"}, where="out")
+    """
+)
+
+
+def test_a_kill_while_the_marker_is_written_leaves_nothing_for_the_next_run(tmp_path: Path):
+    # the random-kill test found it: a run killed while writing its marker left a temporary
+    # with every file and half a marker, which the next run could not read as a run and so
+    # moved aside as "kept" (a user's files would be): the marker is now written whole or not
+    # at all, and the next run removes the temporary entirely
+    out = tmp_path / "run"
+    proc = subprocess.run([sys.executable, "-c", _KILLED_IN_MARKER, str(out)], timeout=60)
+    assert proc.returncode == 9
+    assert (out / "a.txt").read_text() == "first"  # the first run, untouched
+    write_run_directory(out, {"a.txt": "third"}, where="out")
+    assert _listing(tmp_path) == ["run"]  # no temporary, nothing kept aside
+    assert (out / "a.txt").read_text() == "third"
+
+
 def _locked(path: Path) -> int:
     """An open, locked lock file at ``path`` (a run that is still writing): its descriptor."""
     import fcntl

@@ -659,7 +659,11 @@ def write_run_directory(
                     fh.write(data)
                 manifest[Path(name).as_posix()] = hashlib.sha256(data).hexdigest()
             marker = {"microg_run": _MANIFEST_VERSION, "files": dict(sorted(manifest.items()))}
-            (tmp / RUN_MARKER).write_text(json.dumps(marker, indent=1) + "\n", encoding="utf-8")
+            # the marker appears whole or not at all (a kill while writing it leaves a part
+            # file, and the temporary is then entirely microg's for the next run to remove)
+            part = tmp / f"{RUN_MARKER}.part"
+            part.write_text(json.dumps(marker, indent=1) + "\n", encoding="utf-8")
+            os.rename(part, tmp / RUN_MARKER)
             os.chmod(tmp, 0o777 & ~_umask())
             if target.exists():
                 _check_replaceable(target, text, where)  # again, just before the swap
