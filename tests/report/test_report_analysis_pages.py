@@ -65,6 +65,9 @@ def test_each_point_lists_its_verdict_per_criterion() -> None:
     assert r.observations["lab"].verdict == r.verdict == "undecided"
     assert "do NOT comply" not in page and "does not comply" not in page
     assert "undecided: no observed point fails a judged criterion" in page
+    # a 100-s interval in a 20-s record: the interval column says why it is empty
+    assert r.observations["lab"].interval["count"] == 0
+    assert "none: the record is shorter than the interval" in page
     # the notebook's table says the same word
     nb = r._repr_html_()
     assert "<td>undecided (the record cannot decide a criterion)</td>" in nb
