@@ -85,6 +85,16 @@ def test_out_directory(tmp_path, capsys):
     data = json.loads((out_dir / "quasi-steady.json").read_text())
     assert data["atmosphere"]["model"].startswith("exponential")
     assert data["drag"]["cd"] == 2.1 and data["drag"]["area_m2"] == pytest.approx(900.0)
+    # the map's CSV as the csv module reads it: one field per column on every row, labels
+    # with commas whole (the IOC's "main/Horizontal lab, SAA0207 and SAA0201")
+    import csv
+
+    with open(out_dir / "quasi-steady-map.csv", newline="", encoding="utf-8") as fh:
+        rows = list(csv.reader(fh))
+    head, body = rows[0], rows[1:]
+    assert body and all(len(r) == len(head) for r in body)
+    labels = {r[0] for r in body}
+    assert any("," in lab for lab in labels), sorted(labels)[:5]
 
 
 def test_rate_attitude_with_units(capsys):
