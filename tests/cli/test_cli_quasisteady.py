@@ -59,7 +59,7 @@ def test_table_output_and_a_fail_certain_without_drag(capsys):
     # exceeds 1 micro-g: the verdict is a fail, and it says no drag input would change it
     rc, out, err = _run(capsys, "ioc")
     assert rc == 0 and err == ""
-    assert "verdict: does not comply whatever the drag" in out and "no drag input" in out
+    assert "verdict: DOES NOT COMPLY whatever the drag" in out and "no drag input" in out
     lab = next(line for line in out.splitlines() if line.strip().startswith("lab "))
     assert "EXCEEDS whatever the drag (>= 1.41)" in lab
     assert "cm" in out

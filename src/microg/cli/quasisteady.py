@@ -383,7 +383,7 @@ def _summary(result: Any, out_dir: Path | None) -> None:
     )
     for name, p in result.points.items():
         a = p.accel_mps2 * ug
-        verdict = {True: "complies", False: "EXCEEDS", None: "withheld"}[p.complies]
+        verdict = {True: "complies", False: "EXCEEDS", None: "undecided"}[p.complies]
         if p.complies is False and p.peak_lower_bound_mps2 is not None:
             verdict += f" whatever the drag (>= {p.peak_lower_bound_mps2 * ug:.3g})"
         click.echo(
@@ -401,7 +401,7 @@ def _summary(result: Any, out_dir: Path | None) -> None:
                 else ""
             )
         )
-    overall = {True: "complies", False: "does not comply", None: "withheld"}[result.complies]
+    overall = {True: "complies", False: "DOES NOT COMPLY", None: "UNDECIDED"}[result.complies]
     if result.complies is False and result.drag.beta(result.mass_kg) is None:
         overall += " whatever the drag (no drag input needed)"
     click.echo(f"verdict: {overall}")
