@@ -213,3 +213,70 @@ def test_console_gives_one_verdict_line_per_criterion(tmp_path: Path, capsys) ->
     iso = next(line for line in lines if line.startswith("    isolation: "))
     assert iso.startswith("    isolation: undecided: ") and "peak limit" not in iso
     assert d["isolation"]["status"] == "undecided" and d["peak_limit_g"] is None
+
+
+def _listed_bands(warning: str) -> list[float]:
+    """The band centres an unresolved-bands warning lists: each entry reads 'F Hz (RMS g > '."""
+    import re
+
+    return [float(f) for f in re.findall(r"(?:: |; )([0-9.]+) Hz \([0-9.e+-]+ g > ", warning)]
+
+
+def test_one_warning_per_kind_per_point_on_the_console_and_the_page(tmp_path: Path, capsys):
+    # a 20-s record at two points: each has unresolved bands whose estimates exceed (lab 3,
+    # keel-tip 8) and exceeds the unverified 10 micro-g s criterion (reported only).  Reference:
+    # results.json's own fields (the bands not resolved whose RMS exceeds the limit, the
+    # criteria).  Kinds: one unresolved-bands warning per point listing each band once; the
+    # reported-only exceedance is its criterion line only (not repeated as a warning, which
+    # holds what makes the verdict shaky).
+    import html
+    import re
+
+    out_dir = tmp_path / "o"
+    rc, out, err = _run(
+        capsys,
+        ["analyze", "--duration", "20", "--observe", "lab", "--observe", "keel-tip",
+         "--out", str(out_dir), "--no-progress"],
+    )  # fmt: skip
+    assert rc == 0, err
+    d = json.loads((out_dir / "results.json").read_text())
+    console = [ln.strip()[len("warning: ") :] for ln in out.splitlines() if "warning:" in ln]
+    assert all(ln.startswith("  warning: ") for ln in out.splitlines() if "warning:" in ln)
+    # the console shows exactly the JSON's warnings, once each
+    assert console == d["warnings"] and len(set(console)) == len(console)
+    page = (out_dir / "report.html").read_text()
+    blocks = re.findall(r'<p class="warn"><b>Warning:</b> (.*?)</p>', page, flags=re.S)
+    assert [html.unescape(b) for b in blocks] == d["warnings"]  # and the page the same
+    assert page.count('<p class="warn">') == len(blocks)  # no other warning block
+    criteria = {c["name"] for o in d["observations"].values() for c in o["criteria"]}
+    for name, o in d["observations"].items():
+        mine = [w for w in console if w.startswith(f"{name}: ")]
+        to = o["third_octave"]
+        n = len(to["center_hz"])
+        # bands not resolved whose worst-axis RMS exceeds the limit, from the band table
+        over = [
+            to["center_hz"][i]
+            for i in range(n)
+            if not to["resolved"][i]
+            and max(to["rms_g_axis"][a][i] for a in to["rms_g_axis"]) > to["limit_g"][i]
+        ]
+        assert over == to["unresolved_exceeding_hz"] and len(over) >= 3
+        unresolved = [w for w in mine if "not resolved" in w]
+        assert len(unresolved) == 1  # one warning for the kind at this point
+        listed = _listed_bands(unresolved[0])
+        # each band once, the same bands (centres printed to 4 significant digits)
+        assert len(listed) == len(set(listed)) == len(over)
+        assert listed == pytest.approx(over, rel=5e-4)
+        assert unresolved[0].startswith(f"{name}: {len(over)} bands are not resolved")
+        # a criterion's exceedance is its line, not also a warning
+        assert not any(c in w for w in mine for c in criteria)
+        rep = [c for c in o["criteria"] if c["status"] == "reported" and c["complies"] is False]
+        assert "integrated-10ug-s-per-axis-10s" in {c["name"] for c in rep}
+        # this point's block: its headline, then its indented lines up to the next point
+        block = out.split(f"\n  {name}: ", 1)[1].splitlines()[1:]
+        block = block[: next((i for i, ln in enumerate(block) if ln[:4] != "    "), len(block))]
+        for c in rep:
+            lines = [ln for ln in block if ln.startswith(f"    {c['name']}: ")]
+            assert len(lines) == 1 and "reported only: FAILS" in lines[0]
+    # one warning per kind per point, and nothing else here: 2 points, 1 kind each
+    assert len(console) == len(d["observations"]) == 2

@@ -2,7 +2,9 @@
 
 References: the named points' translation maps give each point's modal displacement
 independently of the sample machinery (``PointMap.translation @ phi``); the deformed shape is
-the definition ``position + 0.1 size u / max|u|``.
+the definition ``position + 0.1 size u / max|u|``; the force cones and observed markers are
+compared with the analysis's own options (``Disturbance.unit_direction``, the points'
+positions); the frame titles with ``Modes.effective_mass_fraction``.
 """
 
 from __future__ import annotations
@@ -11,7 +13,10 @@ import numpy as np
 import pytest
 
 import microg
+from microg.dynamics.modes import solve_modes
+from microg.models.toml import load_station
 from microg.plotting.interactive import model as interactive
+from microg.structure.ritz import build_ritz
 
 
 @pytest.fixture(scope="module")
@@ -81,3 +86,101 @@ def test_notebook_tables_follow_the_results(modes):
         assert ("<td>fails</td>" in row) == (o.verdict == "fails")
     fig = r.plot3d()
     assert {t.name for t in fig.data} >= {"model (undeformed)", "mode shape", "force direction"}
+
+
+@pytest.fixture(scope="module")
+def two_force_analysis():
+    # two push-offs in directions off the axes (the default IOC model is planar in x-z), at
+    # two points; isolation off: only the view is under test
+    return microg.analyze(
+        "ioc",
+        force=["crew-pushoff", "crew-pushoff"],
+        at=["crew", "lab"],
+        direction=["1 0 1", "0 0 -1"],
+        observe=["lab", "keel-tip"],
+        duration="20 s",
+        isolation=False,
+    )
+
+
+def _trace(fig, name):
+    found = [t for t in fig.data if t.name == name]
+    assert len(found) == 1, [t.name for t in fig.data]
+    return found[0]
+
+
+def test_force_cones_point_along_each_disturbance_at_its_point(two_force_analysis):
+    r = two_force_analysis
+    pts = r.modes.structure.points
+    cone = _trace(r.plot3d(), "force direction")
+    assert cone.anchor == "tail"  # the cone starts at the force point and points away
+    base = np.column_stack([cone.x, cone.y, cone.z]).astype(float)
+    vec = np.column_stack([cone.u, cone.v, cone.w]).astype(float)
+    dist = r.options.disturbances
+    assert len(dist) == 2 and base.shape == vec.shape == (2, 3)
+    for i, d in enumerate(dist):
+        # reference: the analysis's own option and the point's position; exact copies of
+        # float64 values (plotly keeps them), so only the sqrt(2) normalisation rounds (1e-15)
+        np.testing.assert_allclose(base[i], pts[d.point].position, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(vec[i], d.unit_direction, rtol=0, atol=1e-15)
+    # the directions asked, normalised: (1, 0, 1)/sqrt(2) at crew, -z at lab
+    np.testing.assert_allclose(vec[0], np.array([1.0, 0.0, 1.0]) / np.sqrt(2), atol=1e-15)
+    np.testing.assert_allclose(vec[1], [0.0, 0.0, -1.0], atol=0)
+
+
+def test_observed_points_are_one_trace_at_their_positions(two_force_analysis):
+    r = two_force_analysis
+    pts = r.modes.structure.points
+    obs = _trace(r.plot3d(), "observed points")
+    names = list(r.observations)
+    assert list(obs.text) == names == ["lab", "keel-tip"]
+    xyz = np.column_stack([obs.x, obs.y, obs.z]).astype(float)
+    want = np.array([pts[n].position for n in names])
+    # the positions themselves, copied exactly; the shape (2, 3) says no other named point is
+    # in it (the named-points trace holds all five)
+    np.testing.assert_array_equal(xyz, want)
+    assert len(_trace(r.plot3d(), "named points (force red, observed blue)").x) == len(pts) > 2
+
+
+def test_frame_titles_list_the_effective_mass_fractions_above_one_percent(modes):
+    # gravity gradient makes the pitch rotation a libration mode: an elastic mode (framed) that
+    # carries the whole ry effective mass (fraction 1 of the station's inertia), the other
+    # elastic modes none (free-free: exactly 0)
+    gg = solve_modes(build_ritz(load_station("ioc"), "xz", 3, gravity_gradient=True))
+    for m in (gg, modes):
+        frac = m.effective_mass_fraction
+        fig = m.plot3d()
+        elastic = np.flatnonzero(~m.rigid & (m.omega > 0))
+        assert len(fig.frames) == min(elastic.size, interactive.MAX_FRAMES)
+        for f, j in zip(fig.frames, elastic, strict=False):
+            title = f.layout.title.text
+            assert title.startswith(f"mode {j + 1}: {m.freq_hz[j]:.4g} Hz, ")
+            # reference: Modes.effective_mass_fraction; a direction is listed iff its fraction
+            # exceeds 1 % (the threshold of the title), with its percentage to 3 digits
+            shown = {d: v[j] for d, v in frac.items() if v[j] > 0.01}
+            for d, v in frac.items():
+                assert (f" {d} {100 * v[j]:.3g}%" in title) == (d in shown), (title, d, v[j])
+            assert ("below 1% in every direction" in title) == (not shown)
+    lib = int(np.flatnonzero(~gg.rigid & (gg.omega > 0))[0])
+    assert gg.effective_mass_fraction["ry"][lib] == pytest.approx(1.0, rel=1e-9)
+    assert gg.plot3d().frames[0].layout.title.text.endswith("effective mass ry 100%")
+
+
+def test_frame_titles_list_every_participating_direction(modes):
+    # several directions above 1 % and one below: effective masses set by hand (a Modes whose
+    # elastic modes participate, as a constrained or imported model's do)
+    from dataclasses import replace
+
+    j = int(np.flatnonzero(~modes.rigid & (modes.omega > 0))[0])
+    st = modes.structure
+    total = {d: float(np.asarray(r) @ (st.mass @ np.asarray(r))) for d, r in st.rigid_body.items()}
+    eff = {d: np.zeros(modes.n_modes) for d in modes.effective_mass}
+    want = {"x": 0.35, "z": 0.02, "ry": 0.005}
+    for d, share in want.items():
+        if d in eff and total.get(d, 0) > 0:
+            eff[d][j] = share * total[d]
+    m = replace(modes, effective_mass=eff)
+    frac = m.effective_mass_fraction
+    assert frac["x"][j] == pytest.approx(0.35, rel=1e-12)
+    title = m.plot3d().frames[0].layout.title.text
+    assert title.endswith(", effective mass x 35%, z 2%")  # ry 0.5 % is under the threshold

@@ -6,6 +6,9 @@ runs), then each is opened as a copy with an error catcher first in its head and
 layer with one drawn trace per 2-D trace; a 3-D scene with its WebGL canvas, in software);
 no console error, uncaught error or rejected promise.  On the analyze page the mode slider is
 moved as the slider moves it (its own animate arguments) and the shape shown must change.
+Numbers do not wrap: every rendered numeric table cell (a ``td`` without class ``l``) holds one
+line, its content's height below 1.5 of its line height, in a window narrow enough (900 px)
+that long value-and-unit cells would break without the page's ``nowrap`` rule.
 """
 
 from __future__ import annotations
@@ -74,6 +77,21 @@ window.addEventListener("load", async () => {
       title = gd.layout.title.text;
     } catch (e) { window.__errors.push("probe: " + e); }
   }
+  // numeric cells: the height of the cell's content (a range over it: its line boxes) against
+  // its line height ("normal" is about 1.2 font sizes; two lines are >= 2 line heights)
+  let cells = 0;
+  const wrapped = [];
+  for (const td of document.querySelectorAll("td:not(.l)")) {
+    if (!td.textContent.trim()) continue;
+    const range = document.createRange();
+    range.selectNodeContents(td);
+    const box = range.getBoundingClientRect();
+    if (box.height === 0) continue;  // not rendered (in a closed <details>)
+    const st = getComputedStyle(td);
+    const lh = parseFloat(st.lineHeight) || 1.2 * parseFloat(st.fontSize);
+    cells += 1;
+    if (box.height > 1.5 * lh) wrapped.push(td.textContent.trim().slice(0, 40));
+  }
   const b = document.body;
   b.setAttribute("data-images", imgs.length);
   b.setAttribute("data-decoded", decoded);
@@ -82,6 +100,9 @@ window.addEventListener("load", async () => {
   b.setAttribute("data-bad", bad.join(" "));
   b.setAttribute("data-changed", changed);
   b.setAttribute("data-title", title);
+  b.setAttribute("data-cells", cells);
+  b.setAttribute("data-wrapped", wrapped.length);
+  b.setAttribute("data-first-wrapped", (wrapped[0] || "").replace(/"/g, "'"));
   b.setAttribute("data-errors", window.__errors.length);
   b.setAttribute("data-first-error", (window.__errors[0] || "").slice(0, 200));
 });
@@ -90,7 +111,8 @@ window.addEventListener("load", async () => {
 
 _ATTRS = re.compile(
     r'data-images="(\d+)" data-decoded="(\d+)" data-charts="(\d+)" data-drawn="(\d+)" '
-    r'data-bad="([^"]*)" data-changed="(-?\d)" data-title="([^"]*)" data-errors="(\d+)" '
+    r'data-bad="([^"]*)" data-changed="(-?\d)" data-title="([^"]*)" data-cells="(\d+)" '
+    r'data-wrapped="(\d+)" data-first-wrapped="([^"]*)" data-errors="(\d+)" '
     r'data-first-error="([^"]*)"'
 )
 
@@ -134,6 +156,7 @@ def open_in_chromium(html: str) -> dict[str, str]:
                 "--disable-sync",
                 f"--user-data-dir={tmp}/profile",
                 "--virtual-time-budget=8000",
+                "--window-size=900,1200",
                 "--dump-dom",
                 page.as_uri(),
             ],
@@ -143,7 +166,10 @@ def open_in_chromium(html: str) -> dict[str, str]:
         )
     m = _ATTRS.search(proc.stdout)
     assert m is not None, proc.stderr[-2000:]
-    keys = ("images", "decoded", "charts", "drawn", "bad", "changed", "title", "errors", "first")
+    keys = (
+        "images", "decoded", "charts", "drawn", "bad", "changed", "title",
+        "cells", "wrapped", "first_wrapped", "errors", "first",
+    )  # fmt: skip
     return dict(zip(keys, m.groups(), strict=True))
 
 
@@ -170,6 +196,11 @@ def test_report_in_headless_chromium(reports: dict[str, Path], command: str) -> 
     assert got["errors"] == "0", got["first"]
     assert int(got["images"]) == n_png and int(got["decoded"]) == n_png
     assert int(got["charts"]) == n_div and int(got["drawn"]) == n_div, got["bad"]
+    # every numeric cell rendered holds one line (R2: no '4.48e-'/'06' or '30.3 micro-'/'g s');
+    # 1.5 line heights: one line is 1, a second line makes it >= 2, whatever the font
+    n_numeric = len(re.findall(r"<td(?![^>]*\bclass=\"l\b)[ >]", html))  # td without class l
+    assert 0 < int(got["cells"]) <= n_numeric  # cells were measured (not a vacuous pass)
+    assert got["wrapped"] == "0", got["first_wrapped"]
     if command == "analyze":
         assert got["changed"] == "1"
         assert got["title"].startswith("mode ") and " Hz" in got["title"]  # the frame's title

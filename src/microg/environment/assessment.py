@@ -75,7 +75,8 @@ class Assessment:
     record_s : record length ``n dt``, s
     dt_s : sample interval, s
     cutoff_hz : the data's anti-alias cutoff, Hz, or None
-    warnings : lines for the user (unresolved exceedances, unverified criteria exceeded, ...)
+    warnings : what makes the verdict shaky (unresolved exceedances, no band resolved, no PIMS
+        block, ...); an exceeded criterion is its line in ``criteria``, not a warning
     spectrum : the PSD used for the bands (of the demeaned record)
     """
 
@@ -468,7 +469,9 @@ def assess(
             integrated=integ,
             basis=transient_basis,
         )
-        warnings.extend(verdict.warnings())
+        # an exceeded transient criterion is its criterion's line (``criteria``: judged or
+        # reported only, with its source), printed once on the console and the page; it is not
+        # repeated in ``warnings``, which hold what makes the verdict shaky
         complies = complies and verdict.complies_verified
     return Assessment(
         axes=axes,

@@ -159,25 +159,6 @@ class TransientVerdict:
         """Every criterion of the set is traced to a public source."""
         return all(c.criterion.verified for c in self.checks)
 
-    def warnings(self) -> list[str]:
-        """One line per exceeded criterion, saying whether it enters the verdict."""
-        out = []
-        for c in self.checks:
-            if c.complies:
-                continue
-            cr = c.criterion
-            if cr.is_integral:
-                what = f"{c.value / G0 * 1e6:.3g} micro-g s > {cr.limit / G0 * 1e6:.3g}"
-            else:
-                what = f"{c.value / G0:.3g} g > {cr.limit / G0:.3g} g"
-            tail = (
-                "it enters the verdict"
-                if cr.verified
-                else "its value is unverified, so it is reported but does not enter `complies`"
-            )
-            out.append(f"transient criterion {cr.name} exceeded ({what}); {tail}")
-        return out
-
     def to_dict(self, axes: tuple[str, ...]) -> dict[str, Any]:
         """JSON-ready summary."""
         return {

@@ -2,11 +2,12 @@
 
 The structure's samples are drawn as lines (each beam or body along itself, broken between
 components), the named points as labelled markers, force points in red with a cone along the
-force, observed points in blue.  Every elastic mode is an animation frame chosen with a slider:
-the deformed shape scaled so its largest translation is 10 % of the model's size, titled with its
-frequency, modal mass and largest effective mass.  Above :data:`MAX_SAMPLES` samples the lines are
-decimated (every k-th sample of each component, its ends kept) and the figure says so; above
-:data:`MAX_FRAMES` elastic modes only the lowest are framed, also said.
+force, observed points in blue and ringed (their own trace).  Every elastic mode is an animation
+frame chosen with a slider: the deformed shape scaled so its largest translation is 10 % of the
+model's size, titled with its frequency, modal mass and the effective-mass fractions of the
+directions it participates in (above :data:`EFFECTIVE_MASS_SHOWN`).  Above :data:`MAX_SAMPLES`
+samples the lines are decimated (every k-th sample of each component, its ends kept) and the
+figure says so; above :data:`MAX_FRAMES` elastic modes only the lowest are framed, also said.
 
 plotly builds the figure (``plotly.graph_objects``); nothing here writes JavaScript.
 """
@@ -25,12 +26,14 @@ if TYPE_CHECKING:
 
     from microg.dynamics.modes import Modes
 
-__all__ = ["MAX_FRAMES", "MAX_SAMPLES", "modes_3d"]
+__all__ = ["EFFECTIVE_MASS_SHOWN", "MAX_FRAMES", "MAX_SAMPLES", "modes_3d"]
 
 #: largest number of samples drawn as lines; more are decimated per component
 MAX_SAMPLES = 4000
 #: largest number of elastic modes given an animation frame
 MAX_FRAMES = 40
+#: smallest effective-mass fraction (of the station's r^T M r) a frame's title lists
+EFFECTIVE_MASS_SHOWN = 0.01
 #: a named point's hover text: its name and coordinates with their unit
 _HOVER = "%{text}<br>x %{x:.4g} m<br>y %{y:.4g} m<br>z %{z:.4g} m<extra></extra>"
 
@@ -73,16 +76,22 @@ def _lines(p: np.ndarray, groups: list[np.ndarray]) -> tuple[np.ndarray, ...]:
 
 
 def _mode_title(modes: Modes, j: int) -> str:
-    """'mode 7: 0.1269 Hz, modal mass 1.2e+04 kg' (and the largest effective mass, if any).
+    """'mode 7: 0.1269 Hz, modal mass 1.2e+04 kg, effective mass x 35%, ry 12%'.
 
-    The modal mass is the shape's at a largest point motion of 1 m (``Modes.modal_mass``); the
-    effective masses of a free-free structure's elastic modes are exactly zero.
+    The modal mass is the shape's at a largest point motion of 1 m (``Modes.modal_mass``).  The
+    effective masses are given as fractions of the station's ``r_d^T M r_d``
+    (``Modes.effective_mass_fraction``), every direction above :data:`EFFECTIVE_MASS_SHOWN`;
+    a free-free structure's elastic modes have none (their fractions are exactly zero), said
+    as "below 1 % in every direction".  A structure without rigid-body vectors (clamped) has
+    no fractions, and the title gives none.
     """
     text = f"mode {j + 1}: {modes.freq_hz[j]:.4g} Hz, modal mass {modes.modal_mass[j]:.3g} kg"
-    eff = {d: float(np.asarray(v)[j]) for d, v in modes.effective_mass.items() if d in "xyz"}
-    if eff and max(eff.values()) > 0:
-        d = max(eff, key=lambda k: eff[k])
-        text += f", largest effective mass {d} {eff[d]:.3g} kg"
+    frac = {d: float(np.asarray(v)[j]) for d, v in modes.effective_mass_fraction.items()}
+    shown = [f"{d} {100 * v:.3g}%" for d, v in frac.items() if v > EFFECTIVE_MASS_SHOWN]
+    if shown:
+        text += ", effective mass " + ", ".join(shown)
+    elif frac:
+        text += f", effective mass below {100 * EFFECTIVE_MASS_SHOWN:g}% in every direction"
     return text
 
 
@@ -102,7 +111,7 @@ def modes_3d(
     force_points : mapping of str to ndarray (3,), optional
         Named points where forces act -> unit direction (model frame), drawn in red.
     observed : sequence of str
-        Named points assessed, drawn in blue.
+        Named points assessed, drawn in blue and ringed.
     title : str, optional
         Figure title (default: the method and the number of modes).
 
@@ -110,7 +119,9 @@ def modes_3d(
     -------
     plotly.graph_objects.Figure
         Trace 0 the undeformed model, trace 1 the deformed shape of the frame shown, then the
-        points; ``frames`` one per elastic mode (``name`` ``"mode N"``).
+        named points, the observed points (``"observed points"``, at their positions, in the
+        order given) and the force cones (``"force direction"``, at each force point along its
+        direction); ``frames`` one per elastic mode (``name`` ``"mode N"``).
     """
     import plotly.graph_objects as go
 
@@ -167,6 +178,21 @@ def modes_3d(
                 name="named points (force red, observed blue)",
                 textposition="top center",
                 marker={"size": 4, "color": colour},
+                hovertemplate=_HOVER,
+            )
+        )
+    seen = [n for n in observed if n in pts]
+    if seen:
+        op = np.array([pts[n].position for n in seen], float).reshape(-1, 3)
+        traces.append(
+            go.Scatter3d(
+                x=op[:, 0],
+                y=op[:, 1],
+                z=op[:, 2],
+                mode="markers",
+                text=seen,
+                name="observed points",
+                marker={"size": 9, "color": "#08306b", "symbol": "circle-open"},
                 hovertemplate=_HOVER,
             )
         )
