@@ -134,7 +134,8 @@ def _judged_failing_bands(res) -> dict[float, float]:
 def test_no_design_when_the_report_rule_refuses_and_the_active_isolator_fails():
     # advise.py's no-design branch is reached only when design_mount raises InputError; with a
     # valid package mass and a band of finite frequencies that is an absorber mass ratio outside
-    # MU_RANGE (analyze accepts any mu > 0: the user's --absorber-mu 200 gets here).  The tone of
+    # MU_RANGE (analyze refuses such a ratio at its boundary; the advice, called directly, gives
+    # this status).  The tone of
     # 20,000 micro-g (0.02 g) RMS at 1 Hz needs 1,111x: the ARIS-class platform would move
     # 2.9 m on its 12.5 mm rattle space, so the active check fails.
     mu = 200.0
@@ -188,3 +189,15 @@ def test_active_recommended_when_no_passive_mount_works_and_the_active_design_co
     assert act["worst_band"]["margin"] >= 1.0
     assert adv.status == "active-recommended" and iso["status"] == "active-recommended"
     assert adv.needed
+
+
+def test_analyze_refuses_an_absorber_ratio_outside_the_designable_range():
+    # the report's absorber formulas (Eqs. 4.3-4.7) hold for MU_RANGE only: a ratio outside it
+    # is refused where it is given, naming the parameter, instead of ending in "no-design"
+    import microg
+    from microg.errors import InputError
+
+    for mu in (MU_RANGE[1] * 2, MU_RANGE[0] / 2):
+        with pytest.raises(InputError, match="must be") as exc:
+            microg.analyze("ioc", observe=["lab"], duration=20.0, absorber_mu=mu)
+        assert exc.value.where == "absorber_mu"

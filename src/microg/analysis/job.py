@@ -138,7 +138,9 @@ def analyze(
     n_modes = None if n_modes is None else _args.integer(n_modes, "n_modes", lo=1)
     damping = _args.number(damping, "damping", lo=0.0, hi=1.0)  # < 1: _check_options
     if absorber_mu is not None:
-        absorber_mu = _args.number(absorber_mu, "absorber_mu", lo=0.0, lo_open=True)
+        from microg.isolation.absorber import MU_RANGE
+
+        absorber_mu = _args.number(absorber_mu, "absorber_mu", lo=MU_RANGE[0], hi=MU_RANGE[1])
     if progress is not None:
         _args.function(progress, "progress")
     if command is not None:
