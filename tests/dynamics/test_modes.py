@@ -129,3 +129,22 @@ def test_modes_api_elastic_fraction_dict_xarray_plot() -> None:
 
     fig = modes.plot()
     assert isinstance(fig, Figure) and fig.axes[0].get_yscale() == "log"
+
+
+def test_rounding_note_only_where_the_assembled_stiffness_bounds_a_frequency_loosely():
+    # the note is the first-order bound eps |phi|^T |K| |phi| / (2 lambda) of a frequency
+    # (see microg.dynamics.modes._rounding_note); on an ordinary deck and on the report's
+    # Ritz model it is below 1e-4 for every mode, so nothing is said (the slender-bar deck
+    # that needs it is tests/validation/test_nastran_decks_real.py's cant_beam)
+    from pathlib import Path
+
+    from microg.models.bdf import load_bdf
+    from microg.structure.discretize import discretize
+
+    deck = Path(__file__).resolve().parents[1] / "data" / "nastran" / "rdop2gpwg_1.dat"
+    for s in (
+        discretize(load_bdf(deck, units="in, lbf, s")),
+        discretize(load_station("ioc"), "ritz"),
+    ):
+        md = solve_modes(s, 12)
+        assert not any("rounding bounds" in n for n in md.notes)

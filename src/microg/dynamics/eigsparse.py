@@ -242,6 +242,13 @@ def _isostatic_inverse(K: sp.csr_matrix, B: np.ndarray, labels: tuple[str, ...] 
     sup = support_coordinates(B)
     keep = np.setdiff1d(np.arange(n), sup)
     kk = K[keep][:, keep].tocsc()
+    # factored with unit diagonal (D K D, D = diag(K)^-1/2): the pivots, and the test of a
+    # mechanism on them, do not depend on the units of the coordinates (a rotation in rad
+    # beside a translation in m or in mm: a slender bar's K_rr / K_tt is r^2, 1 m^2 or 1e-6)
+    dg = np.asarray(kk.diagonal(), float)
+    sc = np.where(dg > 0, 1.0 / np.sqrt(np.where(dg > 0, dg, 1.0)), 1.0)
+    S = sp.diags(sc)
+    kk = sp.csc_matrix(S @ kk @ S)
     lu = _symmetric_lu(kk)
     if lu is None:
         try:
@@ -256,7 +263,7 @@ def _isostatic_inverse(K: sp.csr_matrix, B: np.ndarray, labels: tuple[str, ...] 
         # a zero-stiffness motion beyond the rigid ones: find and name it (small pivots)
         v = _near_null(kk)
         full = np.zeros((n, 1))
-        full[keep, 0] = v
+        full[keep, 0] = sc * v  # back to the coordinates
         raise InputError(
             "the structure has a mechanism: a motion beyond the rigid-body modes has no "
             f"stiffness, mostly {moving_components(full, labels)} (an unrestrained joint or part)",
@@ -266,7 +273,7 @@ def _isostatic_inverse(K: sp.csr_matrix, B: np.ndarray, labels: tuple[str, ...] 
     def apply(y: np.ndarray) -> np.ndarray:
         yy = np.asarray(y, float).reshape(n, -1)
         x = np.zeros_like(yy)
-        x[keep] = lu.solve(yy[keep])
+        x[keep] = sc[:, None] * lu.solve(sc[:, None] * yy[keep])
         return x.reshape(np.shape(y))
 
     return apply

@@ -302,6 +302,46 @@ class Modes:
         )
 
 
+#: a mode's frequency whose rounding bound exceeds this (relative) is said in the notes
+ROUNDING_NOTE_REL = 1e-4
+
+
+def _rounding_note(stiffness: Any, sol: Any) -> list[str]:
+    """A note where the assembled stiffness's rounding bounds an elastic frequency loosely.
+
+    Rounding each entry of ``K`` by ``eps`` moves an eigenvalue by up to
+    ``eps |phi|^T |K| |phi|`` (first-order perturbation, ``phi`` M-normalised), so a
+    frequency is known to about half of ``eps |phi|^T |K| |phi| / lambda``: near 1 when the
+    stiffness spans ~1/eps over the mode (a bar of L/r 1e5 in thousands of elements).  Said
+    when the bound exceeds :data:`ROUNDING_NOTE_REL` for some mode; the bound is the one
+    the mechanism test uses.
+
+    Parameters
+    ----------
+    stiffness : ndarray or sparse (n, n)
+        N/m (SI coordinates).
+    sol : the solver's eigensolution (``omega``, ``phi``, ``rigid``)
+    """
+    el = np.flatnonzero(~np.asarray(sol.rigid) & (np.asarray(sol.omega) > 0))
+    if el.size == 0:
+        return []
+    phi = np.abs(np.asarray(sol.phi)[:, el])
+    energy = np.einsum("ij,ij->j", phi, np.asarray(abs(stiffness) @ phi))
+    lam = np.asarray(sol.omega)[el] ** 2
+    rel = 0.5 * _EPS * energy / lam  # on a frequency: half the eigenvalue's
+    worst = int(np.argmax(rel))
+    if not rel[worst] > ROUNDING_NOTE_REL:
+        return []
+    n_loose = int(np.count_nonzero(rel > ROUNDING_NOTE_REL))
+    return [
+        f"the assembled stiffness's rounding bounds {n_loose} elastic frequencies only loosely: "
+        f"mode {int(el[worst]) + 1} ({sol.omega[el[worst]] / (2 * np.pi):.4g} Hz) to about "
+        f"{100 * rel[worst]:.2g}% (eps |phi|^T |K| |phi| / (2 lambda): the stiffness spans "
+        "nearly 1/eps over it, e.g. a very slender bar in many elements); fewer elements or a "
+        "stiffer section condition it better"
+    ]
+
+
 def effective_mass(
     mass: Any, phi: np.ndarray, rigid_body: Mapping[str, np.ndarray]
 ) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
@@ -429,11 +469,12 @@ def solve_modes(
     rb = structure.rigid_body
     cand = np.column_stack(list(rb.values())) if rb else None
     labels = structure.dof_labels or None
+    flex = None
     if structure.is_sparse:
         from microg.dynamics.eigsparse import solve_sparse  # large frame models
 
         tree = getattr(structure, "tree", None)
-        flex = exact = None
+        exact = None
         if tree is not None and all(d in rb for d in tree.free):
             flex = tree.factor()
             exact = (
@@ -464,6 +505,8 @@ def solve_modes(
         if not nt.endswith("from its equilibrium instead of vibrating about it")
     ]
     notes += _unstable_note(structure, sol)
+    if flex is None:  # not from an exact flexibility: the assembled K's rounding bounds them
+        notes += _rounding_note(structure.stiffness, sol)
     return Modes(
         omega=sol.omega,
         phi=sol.phi,
