@@ -126,6 +126,15 @@ def test_static_report_has_no_interactive_view(tmp_path: Path) -> None:
     assert main(["analyze", "--out", str(out), "--observe", "lab", "--static", *FAST]) == 0
     html = (out / "report.html").read_text()
     assert "plotly" not in html.lower() and "data:image/png;base64," in html
+    # every PNG of the run directory is in the page, byte for byte
+    import base64
+    import re
+
+    embedded = {
+        base64.b64decode(m) for m in re.findall(r'src="data:image/png;base64,([^"]+)"', html)
+    }
+    pngs = sorted(out.glob("*.png"))
+    assert pngs and all(p.read_bytes() in embedded for p in pngs)
 
 
 @pytest.mark.parametrize(

@@ -211,3 +211,20 @@ def test_quasi_steady_map_in_micro_g():
     within = [s == "circle" for s in fig.data[0].marker.symbol]
     assert within == list(r.map.within)
     assert "[micro-g]" in fig.data[0].marker.colorbar.title.text
+
+
+def test_every_hover_of_the_analyze_charts_names_its_unit():
+    # each drawn trace of an observed point's four charts shows its value with a unit on
+    # hover (micro-g, micro-g s, g^2/Hz, Hz, s): the hovertemplate names one
+    r = microg.analyze("ioc", observe=["lab"], duration=40.0, dt=0.02, isolation=False)
+    ob = r.observations["lab"]
+    units = ("micro-g", "g^2/Hz", " Hz", " s")
+    for kind in ("history", "bands", "psd", "integrated"):
+        seen = 0
+        for tr in ob.plot_interactive(kind).data:
+            if tr.hoverinfo == "skip" or tr.visible is False:
+                continue
+            tpl = tr.hovertemplate or ""
+            assert any(u in tpl for u in units), (kind, tr.name, tpl)
+            seen += 1
+        assert seen >= 1, kind  # every chart has a hover
