@@ -112,6 +112,9 @@ def _rotation(rng: np.random.Generator) -> np.ndarray:
     offset=st.floats(-200.0, 200.0),
 )
 @example(seed=339, n_beams=3, offset=4.0)  # a high mode off by 1.09e-7 (see the tolerance)
+# the higher modes of a small tree were solved in the complement of the flexibility's modes
+# (not the assembled K's own): off by 1.1e-5 against a 40-digit solve; now 2.4e-10
+@example(seed=339, n_beams=4, offset=0.0)
 @settings(max_examples=25, deadline=None)
 def test_modes_invariant_under_rigid_motion_of_the_model(seed: int, n_beams: int, offset: float):
     base = random_tree(seed, n_beams)
