@@ -454,18 +454,9 @@ def build_frame(
     G_out: Any
     pinned: list[int] = []
     if massless.size and not (constrained and applied):
-        massless, pinned = _pin_massless_rigid(
-            rigid_rows(fm.positions, fm.positions.mean(axis=0), scalar, fm.working)[fm.independent]
-            if Q is None
-            else np.asarray(
-                Q.T
-                @ rigid_rows(fm.positions, fm.positions.mean(axis=0), scalar, fm.working)[
-                    fm.independent
-                ]
-            ),
-            retained,
-            massless,
-        )
+        r0 = rigid_rows(fm.positions, fm.positions.mean(axis=0), scalar, fm.working)
+        r0 = r0[fm.independent] if Q is None else np.asarray(Q.T @ r0[fm.independent])
+        massless, pinned = _pin_massless_rigid(r0, retained, massless)
         if pinned:
             live = np.setdiff1d(live, pinned)
             warnings.append(
