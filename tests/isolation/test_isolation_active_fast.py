@@ -187,3 +187,83 @@ def test_time_response_matches_control_forced_response(aris) -> None:
     assert not np.any(got[~live])
     # at rest with a zero input
     assert not np.any(verify.foh_response(sub, t, np.zeros((3, t.size))))
+
+
+def _forget() -> None:
+    """Empty every result microg keeps for the isolator (the next call computes afresh)."""
+    from microg.isolation.active import controller, fresp
+
+    for kept in (
+        fresp._CACHE,
+        verify._MARGINS_CACHE,
+        verify._LOOPS_CACHE,
+        verify._CL_CACHE,
+        verify._PYU_CACHE,
+        controller._CHANNEL_CACHE,
+        controller._GAINS_CACHE,
+    ):
+        kept.clear()
+
+
+def test_kept_frequency_responses_are_each_systems_own_and_read_only() -> None:
+    rng = np.random.default_rng(5)
+    f = np.geomspace(0.01, 100.0, 50)
+    a = -np.diag(rng.uniform(1.0, 10.0, 4))
+    b, c = rng.standard_normal((4, 2)), rng.standard_normal((3, 4))
+    one = ct.ss(a, b, c, np.zeros((3, 2)))
+    two = ct.ss(a, b, 2.0 * c, np.zeros((3, 2)))  # same shapes, other values
+    r1 = freq_response(one, f)
+    r2 = freq_response(two, f)
+    assert np.array_equal(r2, 2.0 * r1)  # not the first one's kept response
+    assert freq_response(one, f) is r1  # kept
+    with pytest.raises(ValueError):
+        r1[0, 0, 0] = 0.0  # a kept response cannot be changed by a caller
+    assert not np.array_equal(freq_response(one, f[::2]), r1)  # other frequencies: computed
+    assert freq_response(ct.ss(a, b, c, np.zeros((3, 2)), 0.01), f).shape == r1.shape
+    assert not np.array_equal(freq_response(ct.ss(a, b, c, np.zeros((3, 2)), 0.01), f), r1)
+
+
+def test_kept_margins_and_loops_equal_a_fresh_computation(aris) -> None:
+    plant, ctrl = aris
+    f = np.geomspace(0.01, 100.0, 40)
+    slow = design_feedback(plant.with_(max_loop_hz=2.0), target_by_name("g-limit"))
+    _forget()
+    fresh = [verify.loop_margins(p, k, freq_hz=f) for p, k in ((plant, ctrl), (plant, slow))]
+    fresh_d = verify.loop_margins(plant, ctrl, discrete=True)
+    kept = [verify.loop_margins(p, k, freq_hz=f) for p, k in ((plant, ctrl), (plant, slow))]
+    # bit for bit: the same numbers, whether computed or kept, and each controller its own
+    for (m0, l0), (m1, l1) in zip(fresh, kept, strict=True):
+        assert m0 == m1 and np.array_equal(l0, l1)
+    assert fresh[0][0] != fresh[1][0]
+    assert verify.loop_margins(plant, ctrl, discrete=True)[0] == fresh_d[0]
+    # kept margins with frequencies not seen before: the loops computed, the margins kept
+    g = np.geomspace(0.02, 50.0, 30)
+    _, at_g = verify.loop_margins(plant, ctrl, freq_hz=g)
+    _forget()
+    assert np.array_equal(verify.loop_margins(plant, ctrl, freq_hz=g)[1], at_g)
+    # and both are the loops of H = K P_yu at those frequencies (computed here on their own)
+    h = np.einsum("ijf,jkf->ikf", freq_response(ctrl.system, g), verify.plant_yu_response(plant, g))
+    assert np.array_equal(verify.loops_at_a_time(h), at_g)
+    assert verify.closed_loop(plant, ctrl) is verify.closed_loop(plant, ctrl)
+    assert verify.closed_loop(plant, slow) is not verify.closed_loop(plant, ctrl)
+
+
+def test_a_design_is_the_same_whether_computed_or_kept() -> None:
+    from dataclasses import fields as dc_fields
+
+    from microg.isolation.active.design import design_active
+
+    t = np.arange(0.0, 20.0, 0.01)
+    a0 = 1e-5 * np.sin(2 * np.pi * np.outer([0.3, 1.1, 4.0], t))
+    _forget()
+    first = design_active("aris", target={1.0: 30.0}, timepts=t, base_accel=a0)
+    again = design_active("aris", target={1.0: 30.0}, timepts=t, base_accel=a0)
+    other = design_active("aris", target={2.0: 30.0}, timepts=t, base_accel=2 * a0)
+    _forget()
+    cold = design_active("aris", target={2.0: 30.0}, timepts=t, base_accel=2 * a0)
+    assert first.to_dict() == again.to_dict()
+    assert other.to_dict() == cold.to_dict()
+    for fld in dc_fields(cold):
+        v, w = getattr(other, fld.name), getattr(cold, fld.name)
+        if isinstance(v, np.ndarray):
+            assert np.array_equal(v, w, equal_nan=True), fld.name

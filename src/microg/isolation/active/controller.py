@@ -52,6 +52,7 @@ __all__ = [
     "Controller",
     "CONTROLLERS",
     "feedback_controller",
+    "channel_margins_ok",
     "channel_transmissibility",
     "design_feedback",
     "loop_margin_values",
@@ -254,6 +255,35 @@ def _margins_ok(loop: Any) -> tuple[bool, float, float]:
     return abs(math.log(gm)) >= math.log(GM_MIN) and pm >= PM_MIN_DEG, gm, pm
 
 
+#: channel loops' margin checks already made (by plant, channel, gains and Pade order): the
+#: centring search of every design of one plant tries the same loops
+_CHANNEL_CACHE: dict[tuple[Any, ...], bool] = {}
+_CHANNEL_CACHE_SIZE = 256
+
+
+def channel_margins_ok(
+    plant: ActivePlant, i: int, omega_a: float, omega_p: float, pade_order: int = 3
+) -> bool:
+    """Whether decoupled channel ``i``'s loop is stable with the design margins (GM, PM).
+
+    Parameters
+    ----------
+    plant : the plant
+    i : channel (0-5: x, y, z, rx, ry, rz)
+    omega_a : acceleration-loop gain, rad/s
+    omega_p : centring frequency, rad/s
+    pade_order : order of the delay's Pade approximant
+    """
+    key = (plant_key(plant), i, float(omega_a), float(omega_p), pade_order)
+    hit = _CHANNEL_CACHE.get(key)
+    if hit is None:
+        hit = _margins_ok(_channel_loop(plant, i, omega_a, omega_p, pade_order))[0]
+        if len(_CHANNEL_CACHE) >= _CHANNEL_CACHE_SIZE:
+            _CHANNEL_CACHE.pop(next(iter(_CHANNEL_CACHE)))
+        _CHANNEL_CACHE[key] = hit
+    return hit
+
+
 def _largest(ok: Any, lo: float, hi: float, rel: float = 0.01) -> float | None:
     """Largest x in [lo, hi] with ok(x) (ok assumed monotone: true below, false above)."""
     if ok(hi):
@@ -291,7 +321,7 @@ def accel_loop_gains(plant: ActivePlant, pade_order: int = 3) -> np.ndarray:
     wa = np.zeros(6)
     for i in range(6):
         best = _largest(
-            lambda w, i=i: _margins_ok(_channel_loop(plant, i, w, OMEGA_P_MIN, pade_order))[0],
+            lambda w, i=i: channel_margins_ok(plant, i, w, OMEGA_P_MIN, pade_order),
             2 * math.pi * 1e-3,
             top,
         )
@@ -352,10 +382,7 @@ def design_feedback(plant: ActivePlant, target: Target, *, pade_order: int = 3) 
             )
             best = OMEGA_P_MIN
         # the centring loop must keep the margins too (halved until it does)
-        while (
-            best > OMEGA_P_MIN
-            and not _margins_ok(_channel_loop(plant, i, wa[i], best, pade_order))[0]
-        ):
+        while best > OMEGA_P_MIN and not channel_margins_ok(plant, i, wa[i], best, pade_order):
             best = max(0.5 * best, OMEGA_P_MIN)
         wp_t[i] = best
         if pass_f is not None:

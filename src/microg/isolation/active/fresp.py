@@ -13,19 +13,53 @@ quadrature nodes, the margins' grid).  Here ``A`` is brought once to complex Sch
 The unitary reduction keeps the accuracy of the per-point method (the test suite compares it
 with python-control's own response).  Frequencies are taken in blocks of :data:`BLOCK` to bound
 memory.
+
+Responses are kept (:data:`CACHE_BYTES` in all, least recently used dropped first), keyed by
+the system's matrices, its sampling time and the frequencies, all by value: ``microg analyze``
+checks one controller at every observed point, on the same record's frequencies, and each
+check then costs one lookup.  A kept response is returned read-only.
 """
 
 from __future__ import annotations
 
+import hashlib
 import math
+import threading
+from collections import OrderedDict
 from typing import Any
 
 import numpy as np
 
-__all__ = ["BLOCK", "freq_response"]
+__all__ = ["BLOCK", "CACHE_BYTES", "freq_response", "system_key"]
 
 #: frequencies evaluated together (memory: states x inputs x BLOCK complex numbers)
 BLOCK = 4096
+#: bytes of responses kept in all (one larger than a quarter of it is not kept)
+CACHE_BYTES = 64 * 2**20
+
+_CACHE: OrderedDict[bytes, np.ndarray] = OrderedDict()
+_CACHE_LOCK = threading.Lock()
+
+
+def system_key(system: Any) -> bytes:
+    """A digest of a state space's matrices (shapes and values) and sampling time."""
+    h = hashlib.blake2b(digest_size=20)
+    for m in (system.A, system.B, system.C, system.D):
+        a = np.ascontiguousarray(m, float)
+        h.update(repr(a.shape).encode())
+        h.update(a.tobytes())
+    h.update(repr(float(system.dt) if system.dt is not None else None).encode())
+    return h.digest()
+
+
+def _keep(key: bytes, value: np.ndarray) -> None:
+    if value.nbytes > CACHE_BYTES // 4:
+        return
+    with _CACHE_LOCK:
+        _CACHE[key] = value
+        total = sum(v.nbytes for v in _CACHE.values())
+        while total > CACHE_BYTES:
+            total -= _CACHE.popitem(last=False)[1].nbytes
 
 
 def freq_response(system: Any, freq_hz: np.ndarray) -> np.ndarray:
@@ -35,10 +69,27 @@ def freq_response(system: Any, freq_hz: np.ndarray) -> np.ndarray:
     ----------
     system : ``control.StateSpace`` (continuous, or sampled with its ``dt``)
     freq_hz : (nf,) frequencies, Hz, any order
+
+    Returns a read-only array (it may be shared with earlier and later calls).
     """
+    f = np.ascontiguousarray(freq_hz, float).reshape(-1)
+    key = system_key(system) + hashlib.blake2b(f.tobytes(), digest_size=20).digest()
+    with _CACHE_LOCK:
+        hit = _CACHE.get(key)
+        if hit is not None:
+            _CACHE.move_to_end(key)
+    if hit is not None:
+        return hit
+    out = _response(system, f)
+    out.setflags(write=False)
+    _keep(key, out)
+    return out
+
+
+def _response(system: Any, f: np.ndarray) -> np.ndarray:
+    """The response of the module docstring at ``f`` (Hz), a new writable array."""
     from scipy.linalg import schur
 
-    f = np.asarray(freq_hz, float).reshape(-1)
     a = np.asarray(system.A, float)
     b = np.asarray(system.B, float)
     c = np.asarray(system.C, float)

@@ -41,6 +41,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, fields, replace
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -114,13 +115,7 @@ _CACHE_SIZE = 32
 
 def plant_key(plant: ActivePlant) -> tuple[Any, ...]:
     """A hashable fingerprint of every physical parameter of ``plant`` (arrays by value)."""
-    out: list[Any] = []
-    for f in fields(plant):
-        if f.name in ("sources", "name"):
-            continue
-        v = getattr(plant, f.name)
-        out.append(None if v is None else np.asarray(v, float).tobytes())
-    return tuple(out)
+    return plant._fingerprint
 
 
 @dataclass(frozen=True)
@@ -251,6 +246,12 @@ class ActivePlant:
                     "the umbilical matrix with its coupling is not positive semi-definite",
                     where="k-coupling" if axis == "k" else "c-coupling",
                 )
+        for f in fields(self):  # the arrays are the plant's own, read-only (it is frozen)
+            v = getattr(self, f.name)
+            if isinstance(v, np.ndarray):
+                v = np.array(v, float)
+                v.setflags(write=False)
+                s(self, f.name, v)
 
     # ------------------------------------------------------------------ matrices
 
@@ -314,9 +315,27 @@ class ActivePlant:
 
     def channel(self, i: int) -> tuple[float, float]:
         """Decoupled channel ``i``: ``((M^-1 K)_ii, (M^-1 C)_ii)``, 1/s^2 and 1/s."""
+        k, c = self._channels
+        return float(k[i]), float(c[i])
+
+    @cached_property
+    def _fingerprint(self) -> tuple[Any, ...]:
+        """:func:`plant_key`'s value, formed once (the plant and its arrays are read-only)."""
+        out: list[Any] = []
+        for f in fields(self):
+            if f.name in ("sources", "name"):
+                continue
+            v = getattr(self, f.name)
+            out.append(None if v is None else np.asarray(v, float).tobytes())
+        return tuple(out)
+
+    @cached_property
+    def _channels(self) -> tuple[np.ndarray, np.ndarray]:
+        """Every channel's ``(M^-1 K)_ii`` and ``(M^-1 C)_ii``, (6,) each (formed once)."""
         minv = np.linalg.inv(self.mass_matrix())
-        return float((minv @ self.umbilical_matrix("k"))[i, i]), float(
-            (minv @ self.umbilical_matrix("c"))[i, i]
+        return (
+            np.diag(minv @ self.umbilical_matrix("k")).copy(),
+            np.diag(minv @ self.umbilical_matrix("c")).copy(),
         )
 
     # ---------------------------------------------------------------- state space

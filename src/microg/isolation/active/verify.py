@@ -32,7 +32,7 @@ import numpy as np
 
 from microg.errors import InputError
 from microg.isolation.active.controller import Controller
-from microg.isolation.active.fresp import freq_response
+from microg.isolation.active.fresp import freq_response, system_key
 from microg.isolation.active.margins import margins_from_response
 from microg.isolation.active.plant import DOF_NAMES, ActivePlant, gain, plant_key
 
@@ -148,16 +148,29 @@ def closed_loop(
     pade_order : order of the delay's Pade approximant (continuous model)
 
     With the controller off (``u = 0``) the continuous loop is the platform on its umbilicals
-    alone (12 states): the sensors and the delay carry nothing to the platform.
+    alone (12 states): the sensors and the delay carry nothing to the platform.  Formed once
+    per plant, controller, model and Pade order, and shared: callers must not modify it.
     """
+    key = (plant_key(plant), controller.kind, system_key(controller.system), discrete, pade_order)
+    hit = _CL_CACHE.get(key)
+    if hit is not None:
+        return hit
     if controller.kind == "off" and not discrete:
         # u = 0: the platform on its umbilicals alone (the sensors and the delay carry nothing)
         feed = np.zeros((15, 21))
         feed[:9, :9] = np.eye(9)
-        return plant.physical() * gain(feed)
-    gen = plant.generalized(pade_order, discrete=discrete)
-    k = _controller(plant, controller, discrete)
-    return gen.lft(k, nu=6, ny=12)
+        hit = plant.physical() * gain(feed)
+    else:
+        gen = plant.generalized(pade_order, discrete=discrete)
+        hit = gen.lft(_controller(plant, controller, discrete), nu=6, ny=12)
+    if len(_CL_CACHE) >= _PYU_CACHE_SIZE:
+        _CL_CACHE.pop(next(iter(_CL_CACHE)))
+    _CL_CACHE[key] = hit
+    return hit
+
+
+#: closed loops already formed (by plant, controller, model and Pade order)
+_CL_CACHE: dict[tuple[Any, ...], Any] = {}
 
 
 def poles_stable(system: Any) -> tuple[bool, float]:
@@ -179,26 +192,35 @@ def loop_margins(
 ) -> tuple[list[LoopMargin], np.ndarray]:
     """Margins of each loop broken at its actuator, the other five closed (module docstring).
 
-    Returns the margins and each loop's response ``L_i`` at ``freq_hz`` (6, nf), complex.
+    Returns the margins and each loop's response ``L_i`` at ``freq_hz`` (6, nf), complex
+    (read-only: both are kept per plant, controller, model and frequencies).
     """
     k = _controller(plant, controller, discrete)
     model = "discrete" if discrete else "continuous"
     f_top = 0.499 * plant.sample_rate_hz if discrete else 20.0 * plant.sample_rate_hz
     omega = 2 * math.pi * np.geomspace(MARGIN_F_LO_HZ, f_top, MARGIN_POINTS)
     fr = np.asarray(freq_hz if freq_hz is not None else [], float)
-    # H = K P_yu on the margins' grid and the curves' frequencies, from the responses of K and
-    # of the plant's P_yu (the latter kept per plant: every design of one plant shares it);
-    # every loop follows from H by the algebra of the docstring
-    f_all = np.concatenate([omega / (2 * math.pi), fr])
-    p_grid = plant_yu_response(plant, omega / (2 * math.pi), pade_order, discrete)
-    p_fr = plant_yu_response(plant, fr, pade_order, discrete) if fr.size else p_grid[..., :0]
-    p_all = np.concatenate([p_grid, p_fr], axis=2)
+    # the margins are kept per plant and controller; H = K P_yu on the margins' grid (unless
+    # they are kept) and the curves' frequencies, from the responses of K and of the plant's
+    # P_yu (kept per plant); every loop follows from H by the algebra of the docstring
+    key = (plant_key(plant), system_key(k), pade_order, discrete)
+    out = _MARGINS_CACHE.get(key)
+    fr_key = (*key, fr.tobytes())
+    kept = _LOOPS_CACHE.get(fr_key)
+    if out is not None and kept is not None:
+        return list(out), kept
+    grid = omega[:0] if out is not None else omega
+    parts = [f for f in (grid / (2 * math.pi), fr) if f.size]  # Hz; each P_yu kept on its own
+    f_all = np.concatenate(parts) if parts else fr
+    p_all = np.concatenate(
+        [plant_yu_response(plant, f, pade_order, discrete) for f in parts]
+        or [plant_yu_response(plant, fr, pade_order, discrete)],
+        axis=2,
+    )
     h = np.einsum("ijf,jkf->ikf", _fresp(k, f_all), p_all)
     loops = loops_at_a_time(h)
-    out = []
-    for i, name in enumerate(DOF_NAMES):
-        gm, pm, wgc, wpc = margins_from_response(loops[i, : omega.size], omega)
-        out.append(
+    if out is None:
+        out = tuple(
             LoopMargin(
                 loop=name,
                 model=model,
@@ -207,8 +229,25 @@ def loop_margins(
                 gain_crossover_hz=_freq(wgc),
                 phase_crossover_hz=_freq(wpc),
             )
+            for i, name in enumerate(DOF_NAMES)
+            for gm, pm, wgc, wpc in [margins_from_response(loops[i, : grid.size], grid)]
         )
-    return out, loops[:, omega.size :]
+        if len(_MARGINS_CACHE) >= _PYU_CACHE_SIZE:
+            _MARGINS_CACHE.pop(next(iter(_MARGINS_CACHE)))
+        _MARGINS_CACHE[key] = out
+    at_fr = loops[:, grid.size :].copy()
+    at_fr.setflags(write=False)
+    if len(_LOOPS_CACHE) >= _PYU_CACHE_SIZE:
+        _LOOPS_CACHE.pop(next(iter(_LOOPS_CACHE)))
+    _LOOPS_CACHE[fr_key] = at_fr
+    return list(out), at_fr
+
+
+#: loop margins already read (by plant, controller, Pade order and model): every observed
+#: point of one analysis checks the same designed controller
+_MARGINS_CACHE: dict[tuple[Any, ...], tuple[LoopMargin, ...]] = {}
+#: and the loops' responses at the curves' frequencies (by the same and the frequencies)
+_LOOPS_CACHE: dict[tuple[Any, ...], np.ndarray] = {}
 
 
 #: P_yu responses on the margins' grids already computed (by plant, grid, Pade order, model)
