@@ -126,6 +126,33 @@ def test_a_worker_that_dies_loses_only_its_batch(serial, cluster, tmp_path, monk
     _assert_identical(r.dataset.load(), serial)
 
 
+def _die_holding_a_basis(marker: str):
+    """A task that kills its worker once, with the variant's basis in its memory."""
+
+    def task(basis, plan, works, threads):
+        from distributed import get_worker
+
+        path = Path(marker) / "died"
+        held = [k for k in get_worker().data if str(k).startswith("solve_basis-")]
+        if held and not path.exists():
+            path.write_text(str(held))
+            os.kill(os.getpid(), signal.SIGKILL)
+        return run_blocks(basis, plan, works, threads)
+
+    return task
+
+
+def test_a_worker_that_dies_with_a_basis_loses_nothing(serial, cluster, tmp_path, monkeypatch):
+    # the basis is a task's result: recomputed by the scheduler, or (its scattered model
+    # already released) solved again by the sweep before its blocks are resubmitted
+    monkeypatch.setattr("microg.study.run.TASK_CASES", 12)
+    r = sweep(
+        _study(), scheduler=cluster.scheduler_address, _task_fn=_die_holding_a_basis(str(tmp_path))
+    )
+    assert (tmp_path / "died").exists()  # a worker holding a basis was killed
+    _assert_identical(r.dataset.load(), serial)
+
+
 def test_a_scheduler_that_does_not_answer_is_one_line() -> None:
     with pytest.raises(InputError) as info:
         sweep(_study(), scheduler="tcp://127.0.0.1:9", timeout_s=1.0)

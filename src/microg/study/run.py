@@ -5,8 +5,11 @@ one BLAS thread), so both give the same bits:
 
 1. every model variant that has blocks left is solved once (:func:`~microg.study.kernel.
    solve_basis`; on a cluster, one task per variant, so the eigen-solves run in parallel);
-2. the variant's modal basis (the modes at the study's points: small) is scattered to every
-   worker once (``client.scatter(basis, broadcast=True)``), with the small plan of the axes;
+2. the variant's modal basis (the modes at the study's points: small) stays on the cluster
+   as the solving task's result, and the small plan of the axes as a task's: each worker
+   fetches them once, and the scheduler recomputes them if the worker holding them dies
+   (a future with lineage; scattered data has none, and a broadcast racing a worker's death
+   waited on the dead worker);
 3. its blocks are grouped into tasks of about a second (:data:`TASK_CASES` cases) and
    submitted, at most a few per worker at a time; each result is written to the store as it
    arrives (:class:`~microg.study.store.SweepStore`), and the progress callback is told.
@@ -479,6 +482,8 @@ def _client(workers: int | None, scheduler: str | None, timeout_s: float) -> Ite
 
 #: times a task whose scattered inputs were lost with a worker is resubmitted
 RESUBMIT = 3
+#: a future's states from which the scheduler will not compute it again
+_GONE = ("cancelled", "lost", "error")
 
 
 def _lost(exc: BaseException) -> bool:
@@ -488,6 +493,11 @@ def _lost(exc: BaseException) -> bool:
 
     lost = (CancelledError, FutureCancelled, KeyError, OSError)
     return isinstance(exc, lost) or "lost" in str(exc).lower()
+
+
+def _identity(value: Any) -> Any:
+    """The value itself (a task whose result is data the cluster can recompute)."""
+    return value
 
 
 def _scatter(client: Any, data: Any, broadcast: bool) -> Any:
@@ -533,9 +543,10 @@ def _scatter(client: Any, data: Any, broadcast: bool) -> Any:
 def _distributed(runner: _Runner, client: Any, task_fn: TaskFn, threads: int) -> None:
     """The sweep on a Dask cluster (see the module docstring).
 
-    Scattered data has no lineage: when a worker dies with the only copy of a variant's
-    basis (or of the plan, or of a model not yet solved), the tasks needing it fail as
-    cancelled; they are resubmitted with the data scattered again (:data:`RESUBMIT` times).
+    The plan and the bases are tasks' results: a worker's death loses none of them for good
+    (the scheduler recomputes them), except a basis whose scattered model went with it; its
+    variant is then solved again before its blocks are resubmitted.  A task that failed
+    because its worker died is resubmitted :data:`RESUBMIT` times.
     """
     from asyncio import CancelledError
 
@@ -543,13 +554,14 @@ def _distributed(runner: _Runner, client: Any, task_fn: TaskFn, threads: int) ->
 
     s = runner.study
     plan = kernel_plan(s)
-    shared: dict[str, Any] = {"plan": _scatter(client, plan, True)}
-    bases: dict[tuple[int, int], Basis] = {}
+    # the plan and each basis as tasks' results (lineage: recomputed if their worker dies),
+    # held here until the sweep ends so that a task submitted later still finds them
+    plan_f = client.submit(_identity, plan, pure=False)
     basis_f: dict[tuple[int, int], Any] = {}
+    again: dict[tuple[int, int], list[list[BlockWork]]] = {}  # blocks waiting on a new basis
     n_threads = max(1, sum(client.nthreads().values()))
     limit = IN_FLIGHT_PER_THREAD * n_threads
     meta: dict[str, tuple[str, tuple[int, int], Any, int]] = {}
-    held: list[Any] = []
     ac = as_completed()
 
     def solve(key: tuple[int, int], attempt: int) -> None:
@@ -560,7 +572,7 @@ def _distributed(runner: _Runner, client: Any, task_fn: TaskFn, threads: int) ->
         ac.add(f)
 
     def submit(key: tuple[int, int], works: list[BlockWork], attempt: int) -> None:
-        f = client.submit(task_fn, basis_f[key], shared["plan"], works, threads, pure=False,
+        f = client.submit(task_fn, basis_f[key], plan_f, works, threads, pure=False,
                           retries=RETRIES)  # fmt: skip
         meta[f.key] = ("blocks", key, works, attempt)
         ac.add(f)
@@ -575,27 +587,29 @@ def _distributed(runner: _Runner, client: Any, task_fn: TaskFn, threads: int) ->
             try:
                 result = fut.result()
             except (Exception, CancelledError) as exc:  # CancelledError is no Exception
+                fut.release()
                 if not _lost(exc) or attempt >= RESUBMIT:
                     raise
                 if kind == "basis":
                     solve(key, attempt + 1)
-                else:  # the data may be gone with the worker: scatter it again (a future
-                    # that looks alive may name data the scheduler has forgotten, and a task
-                    # on it would wait forever); the replaced futures are held until the
-                    # sweep ends, for the tasks still running on them
-                    held.extend((shared["plan"], basis_f[key]))
-                    shared["plan"] = _scatter(client, plan, True)
-                    basis_f[key] = _scatter(client, bases[key], True)
+                elif basis_f[key].status not in _GONE:  # lineage: the same futures serve
                     submit(key, works, attempt + 1)
+                else:  # the basis cannot be recomputed (its scattered model went with a
+                    # worker): the variant is solved again, then these blocks are queued
+                    if key not in again:
+                        solve(key, attempt + 1)
+                    again.setdefault(key, []).append(works)
+                    in_flight -= 1
                 continue
-            finally:
-                fut.release()
             if kind == "basis":
-                runner.basis_done(result)
-                bases[key] = result
-                basis_f[key] = _scatter(client, result, True)
-                queue.extend((key, w) for w in runner.tasks[key])
+                basis_f[key] = fut  # kept (not released) for the variant's block tasks
+                if key in again:
+                    queue.extend((key, w) for w in again.pop(key))
+                else:
+                    runner.basis_done(result)
+                    queue.extend((key, w) for w in runner.tasks[key])
             else:
+                fut.release()
                 in_flight -= 1
                 runner.results(result)
             while queue and in_flight < limit:
