@@ -267,3 +267,21 @@ def test_a_design_is_the_same_whether_computed_or_kept() -> None:
         v, w = getattr(other, fld.name), getattr(cold, fld.name)
         if isinstance(v, np.ndarray):
             assert np.array_equal(v, w, equal_nan=True), fld.name
+
+
+@pytest.mark.parametrize("discrete", [False, True])
+def test_a_sub_system_is_the_selection_by_gains_bit_for_bit(aris, discrete) -> None:
+    plant, ctrl = aris
+    cl = verify.closed_loop(plant, ctrl, discrete=discrete)
+    dt = cl.dt if discrete else None
+    for rows, cols in (
+        (range(3), range(3)),
+        (range(6), range(3, 9)),
+        (range(3), range(9, 21)),
+        ([0, 1, 2, *range(6, 18)], range(3)),
+    ):
+        by_gains = verify._select(18, rows, dt) * cl * verify._inputs(21, cols, dt)
+        direct = verify._sub(cl, rows, cols)
+        for name in "ABCD":
+            assert np.array_equal(getattr(direct, name), getattr(by_gains, name)), name
+        assert direct.dt == by_gains.dt

@@ -35,6 +35,7 @@ The H2 (LQG) design per decoupled axis is :func:`microg.isolation.active.h2.desi
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
@@ -151,8 +152,9 @@ def feedback_controller(plant: ActivePlant, omega_a: np.ndarray, omega_p: np.nda
     return ct.ss(a, b, -mm @ c, d)
 
 
+@functools.cache
 def no_controller() -> Controller:
-    """The controller off: ``u = 0`` (the platform rides on its umbilicals)."""
+    """The controller off: ``u = 0`` (the platform rides on its umbilicals); one shared object."""
     return Controller("off", gain(np.zeros((6, 12))), None, None, ("controller off",))
 
 

@@ -69,13 +69,22 @@ class Target:
         return out
 
     def check_freq_hz(self, per_decade: int = 40) -> np.ndarray:
-        """Frequencies the target is checked at: its segment edges and ``per_decade`` between."""
-        pts = [self.lo_hz, self.hi_hz]
-        for lo, hi in zip(self.lo_hz, self.hi_hz, strict=True):
-            if hi > lo:
-                n = max(2, int(np.ceil(per_decade * np.log10(hi / lo))) + 1)
-                pts.append(np.geomspace(lo, hi, n))
-        return np.unique(np.concatenate(pts))
+        """Frequencies the target is checked at: its segment edges and ``per_decade`` between.
+
+        Formed once per target and ``per_decade`` (a design asks three times), read-only.
+        """
+        kept: dict[int, np.ndarray] = self.__dict__.setdefault("_checks", {})
+        hit = kept.get(per_decade)
+        if hit is None:
+            pts = [self.lo_hz, self.hi_hz]
+            for lo, hi in zip(self.lo_hz, self.hi_hz, strict=True):
+                if hi > lo:
+                    n = max(2, int(np.ceil(per_decade * np.log10(hi / lo))) + 1)
+                    pts.append(np.geomspace(lo, hi, n))
+            hit = np.unique(np.concatenate(pts))
+            hit.setflags(write=False)
+            kept[per_decade] = hit
+        return hit
 
     def span_hz(self) -> tuple[float, float]:
         """Lowest and highest frequency the target constrains, Hz."""
