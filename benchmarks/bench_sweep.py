@@ -13,10 +13,12 @@
 2. **Memory**: 2,520 and 10,080 cases, each in its own process: the peak resident set
    (``resource.getrusage``, which includes the interpreter and the imports).
 3. **Dask** (``--dask``): the 10,080-case study on local clusters of 1 and 2 worker processes
-   (1 thread, 1 BLAS thread each; started, and microg imported on them, before timing), with
-   microg's worker settings (:data:`microg.study.run.WORKER_ENVIRON`) and with distributed's
-   own (``MALLOC_TRIM_THRESHOLD_=65536``); each row's ratio to one process timed in the same
-   round, and each worker's peak resident set.  Wall-clock times (the work is in the workers).
+   (1 thread, 1 BLAS thread each; each started in its round, and the study run on it once
+   untimed), with microg's worker settings (:data:`microg.study.run.WORKER_ENVIRON`) and with
+   distributed's own (``MALLOC_TRIM_THRESHOLD_=65536``); each row's ratio to one process
+   timed in the same round (only the cluster being timed alive: a local cluster's scheduler
+   runs in this process, and idle ones slowed the one-process row), and each worker's peak
+   resident set.  Wall-clock times (the work is in the workers).
 
 Timing: CPU time of this process (``time.process_time``) for parts 1-2 and wall-clock for
 part 3, interleaved rounds, medians of ``--rounds`` (default 5).  BLAS is limited to 1 thread
@@ -263,45 +265,44 @@ def dask_part(n_at: int, rounds: int) -> None:
     from microg.study import loads_study, sweep
 
     study = loads_study(study_text(n_at=n_at), filename="bench.toml")
-    warm = loads_study('[study]\nmodel = "ioc"\n[record]\nduration = "20 s"\n', filename="w")
     configs = [(1, True), (2, True), (1, False), (2, False)]
-    clusters = {k: _cluster(*k) for k in configs}
-    clients = {k: Client(c) for k, c in clusters.items()}
     times: dict[Any, list[float]] = {k: [] for k in (*configs, "one")}
     rss: dict[Any, list[float]] = {}
-    try:
+
+    def peak_mb() -> float:
+        import resource
+
+        return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+
+    # only the cluster being timed is alive: a local cluster's scheduler and client run in
+    # this process (event-loop threads), and idle ones would slow whatever else runs here
+    for _ in range(rounds):
+        with threadpool_limits(1, user_api="blas"), tempfile.TemporaryDirectory() as d:
+            t0 = time.perf_counter()
+            sweep(study, Path(d) / "one")
+            times["one"].append(time.perf_counter() - t0)
         for k in configs:
-            sweep(warm, scheduler=clusters[k].scheduler_address)  # the workers import microg
-        for _ in range(rounds):
-            with threadpool_limits(1, user_api="blas"), tempfile.TemporaryDirectory() as d:
-                t0 = time.perf_counter()
-                sweep(study, Path(d) / "one")
-                times["one"].append(time.perf_counter() - t0)
-            for k in configs:
+            cluster = _cluster(*k)
+            client = Client(cluster)
+            try:
+                with tempfile.TemporaryDirectory() as d:  # the workers' first sweep: untimed
+                    sweep(study, Path(d) / "warm", scheduler=cluster.scheduler_address)
                 with tempfile.TemporaryDirectory() as d:
                     t0 = time.perf_counter()
-                    sweep(study, Path(d) / "out", scheduler=clusters[k].scheduler_address)
+                    sweep(study, Path(d) / "out", scheduler=cluster.scheduler_address)
                     times[k].append(time.perf_counter() - t0)
-        for k in configs:
-            import resource
-
-            def peak_mb() -> float:
-                return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
-
-            rss[k] = list(clients[k].run(peak_mb).values())
-    finally:
-        for c in clients.values():
-            c.close()
-        for c in clusters.values():
-            c.close()
+                rss[k] = list(client.run(peak_mb).values())
+            finally:
+                client.close()
+                cluster.close()
     one = statistics.median(times["one"])
-    print(f"   {study.n_cases:,} cases; one process: {one:.1f} s (median of {rounds})")
+    print(f"   {study.n_cases:,} cases; one process: {one:.2f} s (median of {rounds})")
     for k in configs:
         t = statistics.median(times[k])
         n, mine = k
         which = "microg's worker settings" if mine else "distributed's MALLOC_TRIM_THRESHOLD_=65536"
         mem = ", ".join(f"{x:.0f}" for x in rss[k])
-        print(f"   {n} worker{'s' if n > 1 else ' '} ({which}): {t:.1f} s, {t / one:.2f}x one "
+        print(f"   {n} worker{'s' if n > 1 else ' '} ({which}): {t:.2f} s, {t / one:.2f}x one "
               f"process (speed-up {one / t:.2f}); peak RSS per worker {mem} MB")  # fmt: skip
 
 
