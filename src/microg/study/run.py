@@ -540,13 +540,37 @@ def _scatter(client: Any, data: Any, broadcast: bool) -> Any:
     raise AssertionError("unreachable")  # pragma: no cover
 
 
-def _distributed(runner: _Runner, client: Any, task_fn: TaskFn, threads: int) -> None:
+def _submit_solve(client: Any, study: Study, key: tuple[int, int], threads: int) -> Any:
+    """Submit the modal solve of one (model, variant): the future of its :class:`Basis`."""
+    model, kw = _solve_args(study, *key)
+    model_f = _scatter(client, model, False)  # a model may be large (a modal file's shapes)
+    return client.submit(solve_basis, model_f, threads=threads, pure=False, retries=RETRIES, **kw)
+
+
+def _submit_solves(client: Any, study: Study, threads: int) -> dict[tuple[int, int], Any]:
+    """Every variant's modal solve, submitted before the store is made (they overlap)."""
+    return {
+        (im, iv): _submit_solve(client, study, (im, iv), threads)
+        for im in range(len(study.models))
+        for iv in range(len(study.variants))
+    }
+
+
+def _distributed(
+    runner: _Runner,
+    client: Any,
+    task_fn: TaskFn,
+    threads: int,
+    solving: dict[tuple[int, int], Any] | None = None,
+) -> None:
     """The sweep on a Dask cluster (see the module docstring).
 
-    The plan and the bases are tasks' results: a worker's death loses none of them for good
-    (the scheduler recomputes them), except a basis whose scattered model went with it; its
-    variant is then solved again before its blocks are resubmitted.  A task that failed
-    because its worker died is resubmitted :data:`RESUBMIT` times.
+    The variants' modal solves may have been submitted already (``solving``: before the store
+    was made, so the two overlap).  The plan and the bases are tasks' results: a worker's
+    death loses none of them for good (the scheduler recomputes them), except a basis whose
+    scattered model went with it; its variant is then solved again before its blocks are
+    resubmitted.  A task that failed because its worker died is resubmitted :data:`RESUBMIT`
+    times.
     """
     from asyncio import CancelledError
 
@@ -565,9 +589,8 @@ def _distributed(runner: _Runner, client: Any, task_fn: TaskFn, threads: int) ->
     ac = as_completed()
 
     def solve(key: tuple[int, int], attempt: int) -> None:
-        model, kw = _solve_args(s, *key)
-        model_f = _scatter(client, model, False)  # a model may be large (a modal file's shapes)
-        f = client.submit(solve_basis, model_f, threads=threads, pure=False, retries=RETRIES, **kw)
+        early = solving.pop(key, None) if solving is not None and attempt == 0 else None
+        f = early if early is not None else _submit_solve(client, s, key, threads)
         meta[f.key] = ("basis", key, None, attempt)
         ac.add(f)
 
@@ -579,6 +602,8 @@ def _distributed(runner: _Runner, client: Any, task_fn: TaskFn, threads: int) ->
 
     for key in runner.tasks:
         solve(key, 0)
+    for f in (solving or {}).values():  # solved early, but every block is already written
+        f.cancel()
     queue: deque[tuple[tuple[int, int], list[BlockWork]]] = deque()
     in_flight = 0
     try:
@@ -602,7 +627,10 @@ def _distributed(runner: _Runner, client: Any, task_fn: TaskFn, threads: int) ->
                     in_flight -= 1
                 continue
             if kind == "basis":
-                basis_f[key] = fut  # kept (not released) for the variant's block tasks
+                # kept (not released) for the variant's block tasks; they are submitted once
+                # the basis is there, so the scheduler spreads them over the workers (blocks
+                # submitted on a pending basis all went to the worker solving it)
+                basis_f[key] = fut
                 if key in again:
                     queue.extend((key, w) for w in again.pop(key))
                 else:
@@ -755,6 +783,16 @@ def sweep(
         fresh = out is not None and _is_new(Path(out))
         created = out is not None and not Path(out).exists()
         out_dir = None if out is None else _prepare_out(study, Path(out))
+        solving: dict[tuple[int, int], Any] = {}
+        if client is not None:
+            # the variants' modal solves start on the cluster while the store is made here
+            # (a variant whose blocks are all written already is cancelled); a submission that
+            # fails is made again inside the run, which reports a failure and how to resume
+            try:
+                solving = _submit_solves(client, study, threads)
+            except Exception:  # noqa: BLE001
+                solving = {}
+            stack.callback(lambda: [f.cancel() for f in solving.values()])
         store = SweepStore(study, None if out_dir is None else out_dir / STORE_NAME,
                            restart=restart, where="out")  # fmt: skip
         hint = resume_hint or (
@@ -774,7 +812,7 @@ def sweep(
                         finally:
                             clear_groups()
                     else:
-                        _distributed(runner, client, task_fn, threads)
+                        _distributed(runner, client, task_fn, threads, solving)
         except InputError:
             if fresh and out_dir is not None:  # all of it is this call's: nothing half-written
                 _discard_fresh(out_dir, created)
