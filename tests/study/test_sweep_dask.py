@@ -153,6 +153,40 @@ def test_a_worker_that_dies_with_a_basis_loses_nothing(serial, cluster, tmp_path
     _assert_identical(r.dataset.load(), serial)
 
 
+def _fail_on_variant(variant: str):
+    """A task that always fails for one variant's blocks (its retries too)."""
+
+    def task(basis, plan, works, threads):
+        if basis.variant == variant:
+            raise ValueError("stop here")
+        return run_blocks(basis, plan, works, threads)
+
+    return task
+
+
+def test_a_resumed_sweep_on_dask_solves_only_the_variants_left(serial, cluster, tmp_path):
+    # the variants' solves start before the store is made; on a resume a variant whose blocks
+    # are all written has its solve cancelled, and the others' blocks are computed once
+    out = tmp_path / "out"
+    addr = cluster.scheduler_address
+    with pytest.raises(Exception, match="stop here"):
+        sweep(_study(), out, scheduler=addr, _task_fn=_fail_on_variant("dock-fwd"))
+    first = distributed.Client(addr, set_as_default=False)
+    try:
+        r = sweep(_study(), out, scheduler=addr)
+        assert 0 < r.resumed_blocks < len(list(r.study.blocks()))
+        _assert_identical(r.dataset.load(), serial)
+        r3 = sweep(_study(), out, scheduler=addr)  # every block written: nothing is computed
+        assert r3.computed_blocks == 0
+        _assert_identical(r3.dataset.load(), serial)
+        # nothing of the sweeps is left on the cluster (every future released or cancelled)
+        names = ("solve_basis", "_identity", "run_blocks", "task", "Station")
+        held = [k for keys in first.has_what().values() for k in keys]
+        assert not [k for k in held if str(k).startswith(names)], held
+    finally:
+        first.close()
+
+
 def test_a_scheduler_that_does_not_answer_is_one_line() -> None:
     with pytest.raises(InputError) as info:
         sweep(_study(), scheduler="tcp://127.0.0.1:9", timeout_s=1.0)
