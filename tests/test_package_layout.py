@@ -30,6 +30,7 @@ STAGES: dict[str, int] = {
     "_json": 0,
     "_vectors": 0,
     "_scan": 0,
+    "_kept": 0,
     "_args": 0,
     "models": 1,
     "structure": 2,

@@ -193,14 +193,15 @@ def _forget() -> None:
     """Empty every result microg keeps for the isolator (the next call computes afresh)."""
     from microg.isolation.active import controller, fresp
 
+    fresp.clear_kept()
     for kept in (
-        fresp._CACHE,
         verify._MARGINS_CACHE,
         verify._LOOPS_CACHE,
         verify._CL_CACHE,
         verify._PYU_CACHE,
         controller._CHANNEL_CACHE,
         controller._GAINS_CACHE,
+        verify._POLES_CACHE,
     ):
         kept.clear()
 

@@ -153,38 +153,59 @@ def test_a_worker_that_dies_with_a_basis_loses_nothing(serial, cluster, tmp_path
     _assert_identical(r.dataset.load(), serial)
 
 
-def _fail_on_variant(variant: str):
-    """A task that always fails for one variant's blocks (its retries too)."""
+def _always_die(marker: str):
+    """A task that kills its worker every time (a crash in native code, say)."""
 
     def task(basis, plan, works, threads):
-        if basis.variant == variant:
-            raise ValueError("stop here")
-        return run_blocks(basis, plan, works, threads)
+        with open(Path(marker) / "deaths", "a") as fh:
+            fh.write("x")
+        os.kill(os.getpid(), signal.SIGKILL)
 
     return task
+
+
+def test_a_block_that_kills_every_worker_stops_the_sweep(cluster, tmp_path, monkeypatch):
+    # each death loses the basis with the worker (its scattered model is released once it is
+    # solved): the variant is solved again and the block resubmitted, counted to RESUBMIT, so
+    # the sweep stops with the failure instead of solving and dying without end
+    from microg.study.run import SweepIncompleteError
+
+    monkeypatch.setattr("microg.study.run.TASK_CASES", 10**6)  # one task
+    with pytest.raises(SweepIncompleteError):
+        sweep(_study(), scheduler=cluster.scheduler_address, _task_fn=_always_die(str(tmp_path)))
+    assert 1 <= len((tmp_path / "deaths").read_text()) <= 30
 
 
 def test_a_resumed_sweep_on_dask_solves_only_the_variants_left(serial, cluster, tmp_path):
     # the variants' solves start before the store is made; on a resume a variant whose blocks
     # are all written has its solve cancelled, and the others' blocks are computed once
+    import zarr
+
     out = tmp_path / "out"
     addr = cluster.scheduler_address
-    with pytest.raises(Exception, match="stop here"):
-        sweep(_study(), out, scheduler=addr, _task_fn=_fail_on_variant("dock-fwd"))
-    first = distributed.Client(addr, set_as_default=False)
+    study = _study()
+    sweep(study, out, scheduler=addr)
+    # the "dock-fwd" variant's blocks marked not written, as a sweep stopped part-way leaves
+    left = [b.id for b in study.blocks() if study.variants[b.index[1]].label == "dock-fwd"]
+    grp = zarr.open_group(
+        str(out / "results.zarr"), mode="r+", zarr_format=2, use_consolidated=False
+    )
+    done = grp["sweep/done"]
+    done[left] = False
+    watcher = distributed.Client(addr, set_as_default=False)
     try:
         r = sweep(_study(), out, scheduler=addr)
-        assert 0 < r.resumed_blocks < len(list(r.study.blocks()))
+        assert r.computed_blocks == len(left) and r.resumed_blocks > 0
         _assert_identical(r.dataset.load(), serial)
         r3 = sweep(_study(), out, scheduler=addr)  # every block written: nothing is computed
         assert r3.computed_blocks == 0
         _assert_identical(r3.dataset.load(), serial)
         # nothing of the sweeps is left on the cluster (every future released or cancelled)
-        names = ("solve_basis", "_identity", "run_blocks", "task", "Station")
-        held = [k for keys in first.has_what().values() for k in keys]
+        names = ("solve_basis", "_identity", "run_blocks", "Station")
+        held = [k for keys in watcher.has_what().values() for k in keys]
         assert not [k for k in held if str(k).startswith(names)], held
     finally:
-        first.close()
+        watcher.close()
 
 
 def test_a_scheduler_that_does_not_answer_is_one_line() -> None:

@@ -500,7 +500,7 @@ def _identity(value: Any) -> Any:
     return value
 
 
-def _scatter(client: Any, data: Any, broadcast: bool) -> Any:
+def _scatter(client: Any, data: Any, broadcast: bool, attempts: int = 5) -> Any:
     """``client.scatter``, again after a moment if a worker is leaving (a restart is racing).
 
     Each attempt is bounded by :data:`SCATTER_TIMEOUT_S` of wall time: distributed's own
@@ -530,30 +530,42 @@ def _scatter(client: Any, data: Any, broadcast: bool) -> Any:
             raise box["error"]
         return box["value"]
 
-    for attempt in range(5):
+    for attempt in range(attempts):
         try:
             return attempt_once()
         except (KeyError, OSError):
-            if attempt == 4:
+            if attempt == attempts - 1:
                 raise
             time.sleep(0.5 * (attempt + 1))
     raise AssertionError("unreachable")  # pragma: no cover
 
 
-def _submit_solve(client: Any, study: Study, key: tuple[int, int], threads: int) -> Any:
+def _submit_solve(
+    client: Any, study: Study, key: tuple[int, int], threads: int, attempts: int = 5
+) -> Any:
     """Submit the modal solve of one (model, variant): the future of its :class:`Basis`."""
     model, kw = _solve_args(study, *key)
-    model_f = _scatter(client, model, False)  # a model may be large (a modal file's shapes)
+    # a model may be large (a modal file's shapes): scattered, not put in the task graph
+    model_f = _scatter(client, model, False, attempts)
     return client.submit(solve_basis, model_f, threads=threads, pure=False, retries=RETRIES, **kw)
 
 
 def _submit_solves(client: Any, study: Study, threads: int) -> dict[tuple[int, int], Any]:
-    """Every variant's modal solve, submitted before the store is made (they overlap)."""
-    return {
-        (im, iv): _submit_solve(client, study, (im, iv), threads)
-        for im in range(len(study.models))
-        for iv in range(len(study.variants))
-    }
+    """Every variant's modal solve, submitted before the store is made (they overlap).
+
+    One scatter attempt each: a variant whose submission fails here (the futures made so far
+    are cancelled) is submitted again inside the run, with its retries and its report.
+    """
+    out: dict[tuple[int, int], Any] = {}
+    try:
+        for im in range(len(study.models)):
+            for iv in range(len(study.variants)):
+                out[(im, iv)] = _submit_solve(client, study, (im, iv), threads, attempts=1)
+    except BaseException:
+        for f in out.values():
+            f.cancel()
+        raise
+    return out
 
 
 def _distributed(
@@ -582,7 +594,8 @@ def _distributed(
     # held here until the sweep ends so that a task submitted later still finds them
     plan_f = client.submit(_identity, plan, pure=False)
     basis_f: dict[tuple[int, int], Any] = {}
-    again: dict[tuple[int, int], list[list[BlockWork]]] = {}  # blocks waiting on a new basis
+    # blocks waiting on a variant solved again, with their attempt (it counts to RESUBMIT)
+    again: dict[tuple[int, int], list[tuple[list[BlockWork], int]]] = {}
     n_threads = max(1, sum(client.nthreads().values()))
     limit = IN_FLIGHT_PER_THREAD * n_threads
     meta: dict[str, tuple[str, tuple[int, int], Any, int]] = {}
@@ -600,13 +613,13 @@ def _distributed(
         meta[f.key] = ("blocks", key, works, attempt)
         ac.add(f)
 
-    for key in runner.tasks:
-        solve(key, 0)
-    for f in (solving or {}).values():  # solved early, but every block is already written
-        f.cancel()
-    queue: deque[tuple[tuple[int, int], list[BlockWork]]] = deque()
+    queue: deque[tuple[tuple[int, int], list[BlockWork], int]] = deque()
     in_flight = 0
     try:
+        for key in runner.tasks:
+            solve(key, 0)
+        for f in (solving or {}).values():  # solved early, but every block is already written
+            f.cancel()
         for fut in ac:
             kind, key, works, attempt = meta.pop(fut.key)
             try:
@@ -623,7 +636,7 @@ def _distributed(
                     # worker): the variant is solved again, then these blocks are queued
                     if key not in again:
                         solve(key, attempt + 1)
-                    again.setdefault(key, []).append(works)
+                    again.setdefault(key, []).append((works, attempt + 1))
                     in_flight -= 1
                 continue
             if kind == "basis":
@@ -632,16 +645,16 @@ def _distributed(
                 # submitted on a pending basis all went to the worker solving it)
                 basis_f[key] = fut
                 if key in again:
-                    queue.extend((key, w) for w in again.pop(key))
+                    queue.extend((key, w, a) for w, a in again.pop(key))
                 else:
                     runner.basis_done(result)
-                    queue.extend((key, w) for w in runner.tasks[key])
+                    queue.extend((key, w, 0) for w in runner.tasks[key])
             else:
                 fut.release()
                 in_flight -= 1
                 runner.results(result)
             while queue and in_flight < limit:
-                submit(*queue.popleft(), 0)
+                submit(*queue.popleft())
                 in_flight += 1
     except BaseException:
         for f in list(ac.futures):

@@ -42,6 +42,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from microg._kept import Kept
 from microg.errors import InputError
 from microg.isolation.active.margins import loop_margin_values
 from microg.isolation.active.plant import DOF_NAMES, ActivePlant, gain, plant_key
@@ -259,8 +260,7 @@ def _margins_ok(loop: Any) -> tuple[bool, float, float]:
 
 #: channel loops' margin checks already made (by plant, channel, gains and Pade order): the
 #: centring search of every design of one plant tries the same loops
-_CHANNEL_CACHE: dict[tuple[Any, ...], bool] = {}
-_CHANNEL_CACHE_SIZE = 256
+_CHANNEL_CACHE: Kept[tuple[Any, ...], bool] = Kept(256)
 
 
 def channel_margins_ok(
@@ -279,10 +279,9 @@ def channel_margins_ok(
     key = (plant_key(plant), i, float(omega_a), float(omega_p), pade_order)
     hit = _CHANNEL_CACHE.get(key)
     if hit is None:
-        hit = _margins_ok(_channel_loop(plant, i, omega_a, omega_p, pade_order))[0]
-        if len(_CHANNEL_CACHE) >= _CHANNEL_CACHE_SIZE:
-            _CHANNEL_CACHE.pop(next(iter(_CHANNEL_CACHE)))
-        _CHANNEL_CACHE[key] = hit
+        hit = _CHANNEL_CACHE.put(
+            key, _margins_ok(_channel_loop(plant, i, omega_a, omega_p, pade_order))[0]
+        )
     return hit
 
 
@@ -300,8 +299,7 @@ def _largest(ok: Any, lo: float, hi: float, rel: float = 0.01) -> float | None:
 
 #: acceleration-loop gains already searched, by plant and Pade order (the search depends on
 #: nothing else: ``microg analyze`` designs the same preset for every observed point)
-_GAINS_CACHE: dict[tuple[Any, ...], np.ndarray] = {}
-_GAINS_CACHE_SIZE = 32
+_GAINS_CACHE: Kept[tuple[Any, ...], np.ndarray] = Kept(32)
 
 
 def accel_loop_gains(plant: ActivePlant, pade_order: int = 3) -> np.ndarray:
@@ -335,9 +333,7 @@ def accel_loop_gains(plant: ActivePlant, pade_order: int = 3) -> np.ndarray:
                 fix="raise the sampling rate or the accelerometer bandwidth, or shorten the delay",
             )
         wa[i] = best
-    if len(_GAINS_CACHE) >= _GAINS_CACHE_SIZE:
-        _GAINS_CACHE.pop(next(iter(_GAINS_CACHE)))
-    _GAINS_CACHE[key] = wa.copy()
+    _GAINS_CACHE.put(key, wa.copy())
     return wa
 
 

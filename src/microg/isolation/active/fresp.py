@@ -30,15 +30,18 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["BLOCK", "CACHE_BYTES", "freq_response", "system_key"]
+__all__ = ["BLOCK", "CACHE_BYTES", "clear_kept", "freq_response", "system_key"]
 
 #: frequencies evaluated together (memory: states x inputs x BLOCK complex numbers)
 BLOCK = 4096
-#: bytes of responses kept in all (one larger than a quarter of it is not kept)
+#: bytes of responses kept in all, each counted with :data:`_ENTRY_BYTES` more for its key
+#: and objects (one larger than a quarter of it is not kept)
 CACHE_BYTES = 64 * 2**20
+_ENTRY_BYTES = 512
 
 _CACHE: OrderedDict[bytes, np.ndarray] = OrderedDict()
 _CACHE_LOCK = threading.Lock()
+_CACHE_TOTAL = [0]  # bytes counted in _CACHE
 
 
 def system_key(system: Any) -> bytes:
@@ -53,13 +56,25 @@ def system_key(system: Any) -> bytes:
 
 
 def _keep(key: bytes, value: np.ndarray) -> None:
-    if value.nbytes > CACHE_BYTES // 4:
-        return
+    """Keep ``value`` under ``key``, the least recently used dropped beyond CACHE_BYTES."""
+    size = value.nbytes + _ENTRY_BYTES
+    if value.size == 0 or size > CACHE_BYTES // 4:
+        return  # nothing to keep (an empty response costs nothing to form), or too large
     with _CACHE_LOCK:
+        old = _CACHE.pop(key, None)
+        if old is not None:
+            _CACHE_TOTAL[0] -= old.nbytes + _ENTRY_BYTES
         _CACHE[key] = value
-        total = sum(v.nbytes for v in _CACHE.values())
-        while total > CACHE_BYTES:
-            total -= _CACHE.popitem(last=False)[1].nbytes
+        _CACHE_TOTAL[0] += size
+        while _CACHE_TOTAL[0] > CACHE_BYTES:
+            _CACHE_TOTAL[0] -= _CACHE.popitem(last=False)[1].nbytes + _ENTRY_BYTES
+
+
+def clear_kept() -> None:
+    """Forget every kept response."""
+    with _CACHE_LOCK:
+        _CACHE.clear()
+        _CACHE_TOTAL[0] = 0
 
 
 def freq_response(system: Any, freq_hz: np.ndarray) -> np.ndarray:

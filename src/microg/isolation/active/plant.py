@@ -46,6 +46,7 @@ from typing import Any
 
 import numpy as np
 
+from microg._kept import Kept, frozen_state
 from microg.errors import InputError
 from microg.units import G0
 
@@ -108,9 +109,8 @@ def _scalar(
     return v
 
 
-#: generalized plants already built (by plant, Pade order, model), at most _CACHE_SIZE
-_GEN_CACHE: dict[tuple[Any, ...], Any] = {}
-_CACHE_SIZE = 32
+#: generalized plants already built (by plant, Pade order, model) (the 32 most recent)
+_GEN_CACHE: Kept[tuple[Any, ...], Any] = Kept(32)
 
 
 def plant_key(plant: ActivePlant) -> tuple[Any, ...]:
@@ -252,6 +252,9 @@ class ActivePlant:
                 v = np.array(v, float)
                 v.setflags(write=False)
                 s(self, f.name, v)
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__dict__.update(frozen_state(state))
 
     # ------------------------------------------------------------------ matrices
 
@@ -405,10 +408,7 @@ class ActivePlant:
         key = (plant_key(self), pade_order, discrete)
         hit = _GEN_CACHE.get(key)
         if hit is None:
-            hit = self._generalized(pade_order, discrete)
-            if len(_GEN_CACHE) >= _CACHE_SIZE:
-                _GEN_CACHE.pop(next(iter(_GEN_CACHE)))
-            _GEN_CACHE[key] = hit
+            hit = _GEN_CACHE.put(key, self._generalized(pade_order, discrete))
         return hit
 
     def _generalized(self, pade_order: int, discrete: bool) -> Any:

@@ -25,6 +25,7 @@ from typing import Any
 
 import numpy as np
 
+from microg._kept import frozen_state
 from microg.errors import InputError
 
 __all__ = ["Target", "g_limit_target", "aris_target", "band_target", "target_by_name", "F_TOP_HZ"]
@@ -57,6 +58,15 @@ class Target:
     slope: np.ndarray
     pass_below_hz: float | None
     source: str
+
+    def __post_init__(self) -> None:
+        for name in ("lo_hz", "hi_hz", "level", "slope"):  # its own, read-only (it is frozen)
+            v = np.array(getattr(self, name), float)
+            v.setflags(write=False)
+            object.__setattr__(self, name, v)
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__dict__.update(frozen_state(state))
 
     def limit(self, freq_hz: np.ndarray) -> np.ndarray:
         """Largest allowed ``|T|`` at ``freq_hz`` (inf where the target says nothing)."""

@@ -30,6 +30,7 @@ from typing import Any
 
 import numpy as np
 
+from microg._kept import Kept
 from microg.errors import InputError
 from microg.isolation.active.controller import Controller
 from microg.isolation.active.fresp import freq_response, system_key
@@ -176,14 +177,11 @@ def closed_loop(
     else:
         gen = plant.generalized(pade_order, discrete=discrete)
         hit = gen.lft(_controller(plant, controller, discrete), nu=6, ny=12)
-    if len(_CL_CACHE) >= _PYU_CACHE_SIZE:
-        _CL_CACHE.pop(next(iter(_CL_CACHE)))
-    _CL_CACHE[key] = hit
-    return hit
+    return _CL_CACHE.put(key, hit)
 
 
 #: closed loops already formed (by plant, controller, model and Pade order)
-_CL_CACHE: dict[tuple[Any, ...], Any] = {}
+_CL_CACHE: Kept[tuple[Any, ...], Any] = Kept(16)
 
 
 def poles_stable(system: Any) -> tuple[bool, float]:
@@ -203,14 +201,11 @@ def poles_stable(system: Any) -> tuple[bool, float]:
         dtime = system.isdtime(strict=True)
         worst = float(np.max(np.abs(p)) - 1.0) if dtime else float(np.max(p.real))
         hit = (worst < 0.0, worst)
-    if len(_POLES_CACHE) >= 64:
-        _POLES_CACHE.pop(next(iter(_POLES_CACHE)))
-    _POLES_CACHE[key] = hit
-    return hit
+    return _POLES_CACHE.put(key, hit)
 
 
 #: pole checks already made (by the system's digest)
-_POLES_CACHE: dict[bytes, tuple[bool, float]] = {}
+_POLES_CACHE: Kept[bytes, tuple[bool, float]] = Kept(64)
 
 
 def loop_margins(
@@ -263,27 +258,22 @@ def loop_margins(
             for i, name in enumerate(DOF_NAMES)
             for gm, pm, wgc, wpc in [margins_from_response(loops[i, : grid.size], grid)]
         )
-        if len(_MARGINS_CACHE) >= _PYU_CACHE_SIZE:
-            _MARGINS_CACHE.pop(next(iter(_MARGINS_CACHE)))
-        _MARGINS_CACHE[key] = out
+        _MARGINS_CACHE.put(key, out)
     at_fr = loops[:, grid.size :].copy()
     at_fr.setflags(write=False)
-    if len(_LOOPS_CACHE) >= _PYU_CACHE_SIZE:
-        _LOOPS_CACHE.pop(next(iter(_LOOPS_CACHE)))
-    _LOOPS_CACHE[fr_key] = at_fr
+    _LOOPS_CACHE.put(fr_key, at_fr)
     return list(out), at_fr
 
 
 #: loop margins already read (by plant, controller, Pade order and model): every observed
 #: point of one analysis checks the same designed controller
-_MARGINS_CACHE: dict[tuple[Any, ...], tuple[LoopMargin, ...]] = {}
+_MARGINS_CACHE: Kept[tuple[Any, ...], tuple[LoopMargin, ...]] = Kept(16)
 #: and the loops' responses at the curves' frequencies (by the same and the frequencies)
-_LOOPS_CACHE: dict[tuple[Any, ...], np.ndarray] = {}
+_LOOPS_CACHE: Kept[tuple[Any, ...], np.ndarray] = Kept(16)
 
 
 #: P_yu responses on the margins' grids already computed (by plant, grid, Pade order, model)
-_PYU_CACHE: dict[tuple[Any, ...], np.ndarray] = {}
-_PYU_CACHE_SIZE = 16
+_PYU_CACHE: Kept[tuple[Any, ...], np.ndarray] = Kept(16)
 
 
 def plant_yu_response(
@@ -308,10 +298,7 @@ def plant_yu_response(
         dt = 1.0 / plant.sample_rate_hz if discrete else None
         gen = plant.generalized(pade_order, discrete=discrete)
         p_yu = _select(30, range(18, 30), dt) * gen * _inputs(27, range(21, 27), dt)
-        hit = _fresp(p_yu, f)
-        if len(_PYU_CACHE) >= _PYU_CACHE_SIZE:
-            _PYU_CACHE.pop(next(iter(_PYU_CACHE)))
-        _PYU_CACHE[key] = hit
+        hit = _PYU_CACHE.put(key, _fresp(p_yu, f))
     return hit
 
 
