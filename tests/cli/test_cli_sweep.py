@@ -183,16 +183,23 @@ def test_a_signal_stop_is_never_success(name, study_file, tmp_path, capsys, monk
     import signal
 
     signum = getattr(signal, name)
-    monkeypatch.setattr(
-        "microg.cli._progress.progress_bar", lambda *a, **k: _SignalOnFirstBlock(signum)
-    )
-    out = tmp_path / "out"
-    rc, _, err = _run(capsys, ["sweep", str(study_file), "--out", str(out), "--no-progress"])
-    assert rc == 128 + signum, err
-    assert "sweep stopped after" in err and "to resume" in err
-    monkeypatch.undo()
-    rc, _, err = _run(capsys, ["sweep", str(study_file), "--out", str(out), "--no-progress"])
-    assert rc == 0, err
+    # Python's own SIGINT handler (KeyboardInterrupt), whatever this process inherited: a job
+    # started in the background by a non-interactive shell ignores SIGINT, and so would the
+    # sweep (rightly: it was asked to)
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        monkeypatch.setattr(
+            "microg.cli._progress.progress_bar", lambda *a, **k: _SignalOnFirstBlock(signum)
+        )
+        out = tmp_path / "out"
+        rc, _, err = _run(capsys, ["sweep", str(study_file), "--out", str(out), "--no-progress"])
+        assert rc == 128 + signum, err
+        assert "sweep stopped after" in err and "to resume" in err
+        monkeypatch.undo()
+        rc, _, err = _run(capsys, ["sweep", str(study_file), "--out", str(out), "--no-progress"])
+        assert rc == 0, err
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 def test_a_failure_part_way_exits_1(study_file, tmp_path, capsys, monkeypatch) -> None:
