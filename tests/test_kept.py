@@ -73,3 +73,18 @@ def test_a_plant_and_a_target_after_pickling_keep_nothing_stale() -> None:
         again.hi_hz[0] = 2.0
     with pytest.raises(ValueError):
         target.lo_hz[0] = 2.0  # a target's arrays are its own and read-only
+
+
+def test_a_byte_limit_drops_the_oldest_and_refuses_a_heavy_entry() -> None:
+    kept: Kept[int, bytes] = Kept(100, max_bytes=100, weight=len)
+    for i in range(5):
+        kept.put(i, b"x" * 20)  # 5 x 20 = 100 bytes: all kept
+    assert len(kept) == 5
+    kept.put(5, b"x" * 20)  # 120 bytes: the oldest goes
+    assert kept.get(0) is None and kept.get(5) is not None and len(kept) == 5
+    heavy = b"x" * 26  # more than a quarter of the limit: returned, not kept
+    assert kept.put(9, heavy) is heavy and kept.get(9) is None
+    kept.put(5, b"x")  # replacing an entry counts its new weight only
+    for i in range(6, 10):
+        kept.put(i, b"x" * 20)
+    assert kept.get(5) is not None  # 1 + 4 x 20 + the others still fit after dropping

@@ -9,24 +9,36 @@ from __future__ import annotations
 
 import threading
 from collections import OrderedDict
+from collections.abc import Callable
 from typing import Any, Generic, TypeVar
 
-__all__ = ["Kept", "frozen_state"]
+__all__ = ["Kept", "frozen_array", "frozen_state"]
 
 K = TypeVar("K")
 V = TypeVar("V")
 
 
 class Kept(Generic[K, V]):
-    """At most ``size`` results by key.
+    """At most ``size`` results by key, and optionally at most ``max_bytes`` of them.
 
     Parameters
     ----------
     size : largest number of entries (>= 1)
+    max_bytes : largest sum of the entries' weights, bytes (None: no limit); an entry
+        heavier than a quarter of it is not kept
+    weight : an entry's bytes (needed with ``max_bytes``)
     """
 
-    def __init__(self, size: int) -> None:
+    def __init__(
+        self,
+        size: int,
+        max_bytes: int | None = None,
+        weight: Callable[[V], int] | None = None,
+    ) -> None:
         self._size = max(1, int(size))
+        self._max_bytes = max_bytes
+        self._weight = weight or (lambda value: 0)
+        self._bytes = 0
         self._items: OrderedDict[K, V] = OrderedDict()
         self._lock = threading.Lock()
 
@@ -39,22 +51,42 @@ class Kept(Generic[K, V]):
             return value
 
     def put(self, key: K, value: V) -> V:
-        """Keep ``value`` under ``key`` and return it."""
+        """Keep ``value`` under ``key`` (unless it is too heavy to) and return it."""
+        w = self._weight(value)
+        if self._max_bytes is not None and w > self._max_bytes // 4:
+            return value
         with self._lock:
+            old = self._items.pop(key, None)
+            if old is not None:
+                self._bytes -= self._weight(old)
             self._items[key] = value
-            self._items.move_to_end(key)
-            while len(self._items) > self._size:
-                self._items.popitem(last=False)
+            self._bytes += w
+            while len(self._items) > self._size or (
+                self._max_bytes is not None and self._bytes > self._max_bytes
+            ):
+                self._bytes -= self._weight(self._items.popitem(last=False)[1])
         return value
 
     def clear(self) -> None:
         """Forget every entry."""
         with self._lock:
             self._items.clear()
+            self._bytes = 0
 
     def __len__(self) -> int:
         with self._lock:
             return len(self._items)
+
+
+def frozen_array(value: Any) -> Any:
+    """A read-only float copy of an array (anything else as it is): a frozen object's own."""
+    import numpy as np
+
+    if not isinstance(value, np.ndarray):
+        return value
+    out = np.array(value, float)
+    out.setflags(write=False)
+    return out
 
 
 def frozen_state(state: dict[str, Any]) -> dict[str, Any]:
@@ -65,14 +97,4 @@ def frozen_state(state: dict[str, Any]) -> dict[str, Any]:
     frozen dataclass whose methods keep results restores itself through this
     (``__setstate__``).
     """
-    import numpy as np
-
-    out: dict[str, Any] = {}
-    for name, value in state.items():
-        if name.startswith("_"):
-            continue
-        if isinstance(value, np.ndarray):
-            value = np.array(value)
-            value.setflags(write=False)
-        out[name] = value
-    return out
+    return {k: frozen_array(v) for k, v in state.items() if not k.startswith("_")}

@@ -24,11 +24,11 @@ from __future__ import annotations
 
 import hashlib
 import math
-import threading
-from collections import OrderedDict
 from typing import Any
 
 import numpy as np
+
+from microg._kept import Kept
 
 __all__ = ["BLOCK", "CACHE_BYTES", "clear_kept", "freq_response", "system_key"]
 
@@ -39,9 +39,9 @@ BLOCK = 4096
 CACHE_BYTES = 64 * 2**20
 _ENTRY_BYTES = 512
 
-_CACHE: OrderedDict[bytes, np.ndarray] = OrderedDict()
-_CACHE_LOCK = threading.Lock()
-_CACHE_TOTAL = [0]  # bytes counted in _CACHE
+_KEPT: Kept[bytes, np.ndarray] = Kept(
+    CACHE_BYTES // _ENTRY_BYTES, CACHE_BYTES, lambda v: v.nbytes + _ENTRY_BYTES
+)
 
 
 def system_key(system: Any) -> bytes:
@@ -55,26 +55,9 @@ def system_key(system: Any) -> bytes:
     return h.digest()
 
 
-def _keep(key: bytes, value: np.ndarray) -> None:
-    """Keep ``value`` under ``key``, the least recently used dropped beyond CACHE_BYTES."""
-    size = value.nbytes + _ENTRY_BYTES
-    if value.size == 0 or size > CACHE_BYTES // 4:
-        return  # nothing to keep (an empty response costs nothing to form), or too large
-    with _CACHE_LOCK:
-        old = _CACHE.pop(key, None)
-        if old is not None:
-            _CACHE_TOTAL[0] -= old.nbytes + _ENTRY_BYTES
-        _CACHE[key] = value
-        _CACHE_TOTAL[0] += size
-        while _CACHE_TOTAL[0] > CACHE_BYTES:
-            _CACHE_TOTAL[0] -= _CACHE.popitem(last=False)[1].nbytes + _ENTRY_BYTES
-
-
 def clear_kept() -> None:
     """Forget every kept response."""
-    with _CACHE_LOCK:
-        _CACHE.clear()
-        _CACHE_TOTAL[0] = 0
+    _KEPT.clear()
 
 
 def freq_response(system: Any, freq_hz: np.ndarray) -> np.ndarray:
@@ -89,16 +72,12 @@ def freq_response(system: Any, freq_hz: np.ndarray) -> np.ndarray:
     """
     f = np.ascontiguousarray(freq_hz, float).reshape(-1)
     key = system_key(system) + hashlib.blake2b(f.tobytes(), digest_size=20).digest()
-    with _CACHE_LOCK:
-        hit = _CACHE.get(key)
-        if hit is not None:
-            _CACHE.move_to_end(key)
+    hit = _KEPT.get(key)
     if hit is not None:
         return hit
     out = _response(system, f)
     out.setflags(write=False)
-    _keep(key, out)
-    return out
+    return out if out.size == 0 else _KEPT.put(key, out)  # an empty one costs nothing
 
 
 def _response(system: Any, f: np.ndarray) -> np.ndarray:

@@ -46,7 +46,7 @@ from typing import Any
 
 import numpy as np
 
-from microg._kept import Kept, frozen_state
+from microg._kept import Kept, frozen_array, frozen_state
 from microg.errors import InputError
 from microg.units import G0
 
@@ -247,11 +247,7 @@ class ActivePlant:
                     where="k-coupling" if axis == "k" else "c-coupling",
                 )
         for f in fields(self):  # the arrays are the plant's own, read-only (it is frozen)
-            v = getattr(self, f.name)
-            if isinstance(v, np.ndarray):
-                v = np.array(v, float)
-                v.setflags(write=False)
-                s(self, f.name, v)
+            s(self, f.name, frozen_array(getattr(self, f.name)))
 
     def __setstate__(self, state: dict[str, Any]) -> None:
         self.__dict__.update(frozen_state(state))

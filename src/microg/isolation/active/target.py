@@ -25,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-from microg._kept import frozen_state
+from microg._kept import frozen_array, frozen_state
 from microg.errors import InputError
 
 __all__ = ["Target", "g_limit_target", "aris_target", "band_target", "target_by_name", "F_TOP_HZ"]
@@ -61,9 +61,7 @@ class Target:
 
     def __post_init__(self) -> None:
         for name in ("lo_hz", "hi_hz", "level", "slope"):  # its own, read-only (it is frozen)
-            v = np.array(getattr(self, name), float)
-            v.setflags(write=False)
-            object.__setattr__(self, name, v)
+            object.__setattr__(self, name, frozen_array(np.asarray(getattr(self, name), float)))
 
     def __setstate__(self, state: dict[str, Any]) -> None:
         self.__dict__.update(frozen_state(state))
