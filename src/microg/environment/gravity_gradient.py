@@ -33,12 +33,16 @@ def gravity_gradient_accel(rho_m: np.ndarray, r_cm_m: np.ndarray, mu: float) -> 
     """
     rho = np.asarray(rho_m, dtype=float)
     rc = np.asarray(r_cm_m, dtype=float)
-    s = rc + rho
-    R2 = np.einsum("...i,...i->...", rc, rc)[..., None]
-    S2 = np.einsum("...i,...i->...", s, s)[..., None]
+    # S^2 - R^2 = 2 R . rho + rho . rho, formed from the small terms (no |R + rho| to round)
+    q = 2.0 * (rho @ rc if rc.ndim == 1 else np.einsum("...i,...i->...", rho, rc))
+    q += np.einsum("...i,...i->...", rho, rho)
+    R2 = np.einsum("...i,...i->...", rc, rc)
+    S2 = R2 + q
     R, S = np.sqrt(R2), np.sqrt(S2)
-    two_r_rho = 2.0 * np.einsum("...i,...i->...", rho, rc)[..., None]
-    r_minus_s = -(two_r_rho + np.einsum("...i,...i->...", rho, rho)[..., None]) / (R + S)
     S3 = S2 * S
-    inv_diff = r_minus_s * (R2 + R * S + S2) / (R2 * R * S3)
-    return mu * (rho / S3 + rc * inv_diff)
+    # g(R) - g(s) = (mu / S^3) rho + mu (1/S^3 - 1/R^3) R, with R - S = -q / (R + S)
+    inv_diff = (-mu * q / (R + S)) * (R2 + R * S + S2) / (R2 * R * S3)
+    out = rho * (mu / S3)[..., None]
+    # rc * inv_diff[..., None] broadcasts a length-3 inner loop; the outer product is one call
+    out += inv_diff[..., None] @ rc[None, :] if rc.ndim == 1 else rc * inv_diff[..., None]
+    return out

@@ -500,9 +500,11 @@ def peak_magnitude(static: np.ndarray, varying: np.ndarray) -> np.ndarray:
     """``max_s |static_p + varying_s|`` for every point p, vectorised without a (P, S, 3) array.
 
     Only the convex-hull vertices of the ``varying`` samples can give the maximum
-    (:func:`_hull_vertices`); then ``|q + d_s|^2 = |q|^2 + (|d_s|^2 + 2 q . d_s)`` is one matrix
-    product ``Q D^T`` per block of points and a maximum over s.  Rounding: absolute ~1e-16
-    (|q|^2 + |d|^2), negligible against a micro-g limit.
+    (:func:`_hull_vertices`); then ``|q + d_s|^2 = |q|^2 + (|d_s|^2 + 2 q . d_s)`` and the
+    bracket is one matrix product of the rows ``(2 d_s, |d_s|^2)`` with the columns ``(q, 1)``
+    per block of points, whose largest entry down each column is taken (the vertices along the
+    rows: the maximum runs over contiguous rows).  Rounding: absolute ~1e-16 (|q|^2 + |d|^2),
+    negligible against a micro-g limit.
 
     Parameters
     ----------
@@ -513,15 +515,18 @@ def peak_magnitude(static: np.ndarray, varying: np.ndarray) -> np.ndarray:
     q = np.asarray(static, float)
     d = np.asarray(varying, float)
     d = d[_hull_vertices(d)]
-    d2 = np.sum(d * d, axis=1)
-    dT = 2.0 * d.T
-    out = np.empty(q.shape[0])
-    block = max(64, 2**17 // max(d.shape[0], 1))  # (block, vertices) scratch stays in cache
+    rows = np.empty((d.shape[0], 4))
+    rows[:, :3] = 2.0 * d
+    rows[:, 3] = np.sum(d * d, axis=1)
+    out = np.einsum("ij,ij->i", q, q)
+    block = min(4096, max(64, 2**17 // max(d.shape[0], 1)))  # the scratch stays in cache
+    cols = np.empty((4, min(block, q.shape[0])))
+    cols[3] = 1.0
     for c0 in range(0, q.shape[0], block):
         qb = q[c0 : c0 + block]
-        inner = qb @ dT
-        inner += d2
-        out[c0 : c0 + block] = np.sum(qb * qb, axis=1) + inner.max(axis=1)
+        n = qb.shape[0]
+        cols[:3, :n] = qb.T
+        out[c0 : c0 + n] += (rows @ cols[:, :n]).max(axis=0)
     return np.sqrt(np.maximum(out, 0.0))
 
 
