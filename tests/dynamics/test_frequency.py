@@ -226,6 +226,27 @@ def test_band_rms_matches_quad_with_resonances_inside(fem, zeta):
     assert r.refinements >= 0 and np.all(r.quad_error <= 1e-9)
 
 
+def test_a_loose_tolerance_takes_fewer_nodes_and_still_meets_it(fem):
+    """rtol 1e-3 integrates with 6 Gauss points an interval (not 8) and stays within 1e-3."""
+    _, m = fem
+    f_el = m.freq_hz[~m.rigid]
+    c = np.array([f_el[0], f_el[3], f_el[10]])
+    lo, hi = c / 2 ** (1 / 6), c * 2 ** (1 / 6)
+    psd = fq.ForcePSD([0.05, 0.5, 4.0, 30.0], [0.02, 1.0, 0.1, 1e-3])
+    loads = [fq.Load("p", "boom-tip", "1 0 1", psd)]
+    tight = fq.band_response(m, 0.005, ["lab"], loads, lo, hi)
+    loose = fq.band_response(m, 0.005, ["lab"], loads, lo, hi, rtol=1e-3)
+    assert bandquad.default_order(1e-3) == 6 and bandquad.default_order(1e-9) == 8
+    assert loose.quad_nodes < tight.quad_nodes
+    for k, (a, b) in enumerate(zip(lo, hi, strict=True)):
+        for ax in range(3):
+            ref = _quad_band(m, 0.005, ("lab", ax), "boom-tip", loads[0].direction, psd, a, b)
+            got = loose.rms_mps2[0, ax, k] ** 2
+            # the tolerance asked, on the largest axis's band mean square (quad: 1e-12)
+            scale = np.max(tight.rms_mps2[0, :, k] ** 2)
+            assert abs(got - ref) <= 1e-3 * max(ref, 1e-6 * scale), (k, ax, got, ref)
+
+
 def test_near_far_split_equals_the_full_modal_sum_on_the_same_nodes(fem):
     """The Chebyshev interpolant of the far modes changes nothing: the band mean squares equal
     the full modal sum of |H|^2 S evaluated at the same quadrature nodes (rounding only)."""

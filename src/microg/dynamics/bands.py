@@ -31,7 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from microg.dynamics.bandquad import converged_quadrature
+from microg.dynamics.bandquad import converged_quadrature, default_order
 from microg.dynamics.frf import factor_parts
 from microg.dynamics.spectra import ForceSpectrum, HarmonicLines, same_frequency_index
 from microg.errors import InputError
@@ -282,7 +282,7 @@ def band_mean_squares(
     upper_hz: np.ndarray,
     *,
     groups: Sequence[int] | None = None,
-    order: int = 8,
+    order: int | None = None,
     rtol: float = 1e-9,
     workers: int | None = None,
     contributions: bool = True,
@@ -301,7 +301,7 @@ def band_mean_squares(
         :class:`ForcePSD`), N and Hz
     lower_hz, upper_hz : (nb,) band edges, Hz
     groups : (s,) coherent group index per source (default: all independent)
-    order : Gauss-Legendre points per sub-interval
+    order : Gauss-Legendre points per sub-interval (None: :func:`default_order` of ``rtol``)
     rtol : convergence tolerance of the band integration (relative)
     workers : threads over bands (default the number of CPUs); BLAS keeps the process's threads
     contributions : compute the per-mode contributions (``mode_alone``, ``mode_share``; zero
@@ -365,7 +365,7 @@ def band_mean_squares(
             zm,
             scale,
             spec_list,
-            order,
+            default_order(rtol) if order is None else order,
             rtol,
             weight=None if weight is None else weight_at,
             breakpoints_hz=weight_breakpoints_hz,

@@ -522,7 +522,7 @@ def band_response(
     upper_hz: np.ndarray,
     *,
     center_hz: np.ndarray | None = None,
-    order: int = 8,
+    order: int | None = None,
     rtol: float = 1e-9,
     workers: int | None = None,
     contributions: bool = True,
