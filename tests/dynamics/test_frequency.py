@@ -422,6 +422,25 @@ def test_shares_sum_to_one_and_response_is_linear(case):
     assert np.allclose(r3.rms_mps2, 3 * r.rms_mps2, rtol=1e-10, atol=1e-12 * top)
 
 
+def test_without_contributions_the_bands_are_the_same_and_the_modes_zero(fem):
+    """contributions=False leaves the band and source values bit for bit, mode terms zero."""
+    _, m = fem
+    f_el = m.freq_hz[~m.rigid]
+    c = np.array([f_el[0], f_el[3]])
+    lo, hi = c / 2 ** (1 / 6), c * 2 ** (1 / 6)
+    loads = [
+        fq.Load("p", "boom-tip", "1 0 1", fq.ForcePSD([0.05, 4.0, 30.0], [0.02, 1.0, 1e-3])),
+        fq.Load("b", "vertical-lab", "x", fq.BandForceSpectrum(lo, hi, [0.7, 1.3])),
+        fq.Load("h", "lab", "y", fq.HarmonicLines([0.4], [float(c[1])], [0.0])),
+    ]
+    full = fq.band_response(m, 0.01, ["lab"], loads, lo, hi)
+    bare = fq.band_response(m, 0.01, ["lab"], loads, lo, hi, contributions=False)
+    assert np.any(full.mode_rms_mps2 > 0) and np.any(full.mode_share != 0)
+    np.testing.assert_array_equal(bare.rms_mps2, full.rms_mps2)
+    np.testing.assert_array_equal(bare.source_rms_mps2, full.source_rms_mps2)
+    assert not np.any(bare.mode_rms_mps2) and not np.any(bare.mode_share)
+
+
 def test_mode_alone_is_exact_for_a_single_mode(ritz):
     """With one elastic mode kept, that mode alone is the whole response."""
     _, m = ritz

@@ -177,13 +177,12 @@ def _spectral_band(
             cre, cim = cre[~bad], cim[~bad]
     nr = np.flatnonzero(near)
     mn = nr.size
-    # responses at the nodes, (L, p, nn), amplitude included: H_s = coef_s @ (basis * amp_s)
-    # with the basis [r_near; ell] and the coefficients [c_near, far-mode sum at the points]
+    # responses at the nodes, (L, p, nn), amplitude included: H_s = (coef_s @ basis) amp_s
+    # with the basis [r_near; ell] and the coefficients [c_near, far-mode sum at the points]:
+    # one product for every source and row, then each source's amplitude at each node
     cn = T[None, :, nr] * F[:, None, nr]  # (L, p, mn)
     bre = np.concatenate([rre[nr], ell]) if far.size else rre[nr]  # (K, nn)
     bim = np.concatenate([rim[nr], ell]) if far.size else rim[nr]
-    Rre = bre[None] * amp[:, None, :]  # (L, K, nn)
-    Rim = bim[None] * amp[:, None, :]
     if far.size:
         Tf = T[:, far]
         hf_re = Tf[None] @ (F[:, far, None] * cre[None])  # (L, p, nc): far sum at the points
@@ -192,8 +191,11 @@ def _spectral_band(
         cre_im = np.concatenate([cn, hf_im], axis=2)
     else:
         cre_re = cre_im = cn
-    Hre = cre_re @ Rre  # (L, p, nn)
-    Him = cre_im @ Rim
+    K = bre.shape[0]
+    Hre = (np.ascontiguousarray(cre_re).reshape(L * p, K) @ bre).reshape(L, p, nn)
+    Him = (np.ascontiguousarray(cre_im).reshape(L * p, K) @ bim).reshape(L, p, nn)
+    Hre *= amp[:, None, :]
+    Him *= amp[:, None, :]
     if sw is not None:  # the weighted responses sqrt(w_p) H_p
         Hre = Hre * sw[None]
         Him = Him * sw[None]
@@ -227,6 +229,8 @@ def _spectral_band(
     # nodes are products with the amplitude-scaled basis: near columns give the near modes, the
     # Chebyshev columns the far modes through r_j(n) ~ sum_k r_j(x_k) l_k(n)
     # (a weight enters once more: the mode's term is weighted as the total it projects on)
+    Rre = bre[None] * amp[:, None, :]  # (L, K, nn): the amplitude-scaled basis
+    Rim = bim[None] * amp[:, None, :]
     RreT, RimT = np.swapaxes(Rre, 1, 2), np.swapaxes(Rim, 1, 2)
     w1 = 1.0 if sw is None else sw[None]
     Are = (Hre * w1) @ RreT  # (L, p, K): sum_n Yre a b, Y = H for a source alone in its group
@@ -400,6 +404,7 @@ def band_mean_squares(
                 wm,
                 zm,
                 elastic & (fm > lo[b] - _NEAR_WIDTHS * width) & (fm < hi[b] + _NEAR_WIDTHS * width),
+                contributions=contributions,
                 sw=None if sw_all is None else sw_all[:, n0:n1],
             )
             return b, live, part
