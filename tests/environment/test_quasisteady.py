@@ -250,6 +250,18 @@ def test_peak_magnitude_over_many_blocks_equals_brute_force():
     np.testing.assert_allclose(peak_magnitude(q, d), ref, rtol=1e-10, atol=1e-22)
 
 
+@pytest.mark.parametrize(
+    "bad", [np.zeros(4), np.zeros((2, 2)), [[0.0, 0.0, np.nan]], "x", [[1.0, 2.0, "a"]]]
+)
+def test_peak_at_refuses_bad_positions_naming_them(ioc, bad):
+    res = quasi_steady(ioc, drag=Drag(ballistic_coefficient_kg_per_m2=100.0), with_map=False)
+    with pytest.raises(InputError) as err:
+        res.peak_at(bad)
+    assert "positions_m" in str(err.value) and "p x 3" in str(err.value)
+    # one point as (3,) is a row
+    assert res.peak_at(res.center_of_mass_m).shape == (1,)
+
+
 def test_map_and_zone(ioc):
     res = quasi_steady(ioc, drag=Drag(ballistic_coefficient_kg_per_m2=100.0))
     m = res.map

@@ -78,6 +78,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from microg.environment._inputs import points3
 from microg.environment.attitude import ATTITUDES, LVLH_FROM_STATION, Attitude, rotation_accel
 from microg.environment.drag import (
     AP_DEFAULT,
@@ -388,9 +389,12 @@ class QuasiSteadyResult:
         }
 
     def peak_at(self, positions_m: np.ndarray) -> np.ndarray:
-        """Peak magnitude over the orbit at any positions (p, 3) in the station frame, m/s^2."""
+        """Peak magnitude over the orbit at any positions (p, 3) in the station frame, m/s^2.
+
+        ``positions_m``: (p, 3) points (or one as (3,)) in the model's frame, m.
+        """
         omega, alpha = self.attitude.rates(self.mean_motion_rad_s)
-        pos = np.asarray(positions_m, float).reshape(-1, 3)
+        pos = points3(positions_m, "positions_m")
         return _map_peaks(
             pos,
             self.center_of_mass_m,
