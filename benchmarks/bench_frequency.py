@@ -46,6 +46,7 @@ import argparse
 import dataclasses
 import os
 import time
+import types
 from importlib import resources
 
 import numpy as np
@@ -149,7 +150,7 @@ def log_grid(bands, per_decade: float, breakpoints):  # type: ignore[no-untyped-
             weight.append(w * (u[1] - u[0]) / 3.0 * f)  # df = f du
             count += n
         start.append(start[-1] + count)
-    return argparse.Namespace(
+    return types.SimpleNamespace(
         freq_hz=np.concatenate(freq), weight_hz=np.concatenate(weight), start=np.array(start)
     )
 
@@ -177,7 +178,7 @@ def equal_accuracy(m, z, observe, loads, bands, out, inp):  # type: ignore[no-un
     tried: dict[float, float] = {}  # points per decade -> error
 
     def coarsest(target: float) -> tuple[float, float]:
-        """The coarsest tried density whose error is at most ``target`` (None: cap reached)."""
+        """The coarsest density tried whose error is at most ``target`` (or the cap's), error."""
         k = 0
         while True:
             pd = 100.0 * 2 ** (k / 4)

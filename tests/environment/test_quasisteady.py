@@ -241,10 +241,12 @@ def test_peak_magnitude_equals_brute_force(seed, n_points, n_samples, planar):
 
 
 def test_peak_magnitude_over_many_blocks_equals_brute_force():
-    # 5,003 points against 200 samples: several blocks of points and a ragged last one
+    # 5,003 points against 200 samples on a sphere (every one a hull vertex, so blocks of 655
+    # points): eight blocks, the last one ragged
     rng = np.random.default_rng(7)
     q = rng.normal(size=(5003, 3)) * 1e-6
-    d = rng.normal(size=(200, 3)) * 1e-7
+    d = rng.normal(size=(200, 3))
+    d *= 1e-7 / np.linalg.norm(d, axis=1)[:, None]
     ref = np.sqrt(np.max(np.sum((q[:, None, :] + d[None]) ** 2, axis=-1), axis=1))
     # as above: rounding of |q|^2 + 2 q.d + |d|^2 only
     np.testing.assert_allclose(peak_magnitude(q, d), ref, rtol=1e-10, atol=1e-22)
